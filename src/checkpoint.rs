@@ -1,0 +1,131 @@
+//! Checkpoints: the complete dynamic state (all six Gear values, the spring table, the
+//! random generator, source progress, step count) plus the scene, bit for bit, so that a
+//! resumed run is bitwise identical to an uninterrupted one (SPEC 3).
+
+use crate::create::source::SourceState;
+use crate::files::{Decoder, Encoder, write_atomic};
+use crate::rng::Rng;
+use crate::sim::Simulation;
+use crate::springs::SpringTable;
+use crate::state::{GEAR_VALUES, Particles};
+use std::path::Path;
+
+const MAGIC: &[u8; 8] = b"TALUSCK1";
+
+#[derive(Debug, thiserror::Error)]
+pub enum CheckpointError {
+    #[error("cannot read checkpoint {0}: {1}")]
+    Io(String, std::io::Error),
+    #[error("{0} is not a talus checkpoint (bad magic)")]
+    Magic(String),
+    #[error("checkpoint {0} is damaged: {1}")]
+    Corrupt(String, crate::files::DecodeError),
+    #[error("checkpoint {0} holds an invalid scene: {1}")]
+    Scene(String, crate::scene::SceneError),
+}
+
+pub fn encode(sim: &Simulation) -> Vec<u8> {
+    let mut e = Encoder::default();
+    e.bytes.extend_from_slice(MAGIC);
+    e.str(&serde_json::to_string(&sim.scene).expect("a scene always serialises"));
+    e.u64(sim.step);
+    e.u64(sim.lost);
+    e.u64(sim.rng.state);
+    e.u64(sim.sources.len() as u64);
+    for s in &sim.sources {
+        e.u32(s.inserted);
+        match s.pending {
+            Some([x, d]) => {
+                e.u8(1);
+                e.f64(x);
+                e.f64(d);
+            }
+            None => e.u8(0),
+        }
+    }
+    let p = &sim.particles;
+    e.u64(p.len() as u64);
+    for k in 0..GEAR_VALUES {
+        p.q[k].iter().flatten().for_each(|&v| e.f64(v));
+    }
+    for col in [&p.radius, &p.mass, &p.inertia] {
+        col.iter().for_each(|&v| e.f64(v));
+    }
+    p.fixed.iter().for_each(|&v| e.u8(v as u8));
+    p.active.iter().for_each(|&v| e.u8(v as u8));
+    p.material.iter().for_each(|&v| e.u32(v));
+    e.u64(sim.springs.capacity() as u64);
+    sim.springs.keys.iter().for_each(|&k| e.u64(k));
+    sim.springs.values.iter().for_each(|&v| e.f64(v));
+    e.bytes
+}
+
+pub fn write(sim: &Simulation, path: &Path) -> std::io::Result<()> {
+    write_atomic(path, &encode(sim))
+}
+
+/// Loads a checkpoint; `overrides` may change `stop.*` and `output.*` only (so a run can
+/// be extended), since anything else would break the continuation.
+pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointError> {
+    let name = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| CheckpointError::Io(name.clone(), e))?;
+    if bytes.len() < 8 || &bytes[..8] != MAGIC {
+        return Err(CheckpointError::Magic(name));
+    }
+    let corrupt = |e| CheckpointError::Corrupt(name.clone(), e);
+    let mut d = Decoder::new(&bytes[8..]);
+    let scene_text = d.str().map_err(corrupt)?;
+    for o in overrides {
+        let key = o.split('=').next().unwrap_or("").trim();
+        if !(key.starts_with("stop.") || key.starts_with("output.")) {
+            return Err(CheckpointError::Scene(
+                name,
+                crate::scene::SceneError::invalid(key, "only stop.* and output.* can be changed when resuming"),
+            ));
+        }
+    }
+    let scene = crate::scene::parse(&scene_text, overrides).map_err(|e| CheckpointError::Scene(name.clone(), e))?;
+    let step = d.u64().map_err(corrupt)?;
+    let lost = d.u64().map_err(corrupt)?;
+    let rng = Rng { state: d.u64().map_err(corrupt)? };
+    let n_sources = d.u64().map_err(corrupt)? as usize;
+    let mut sources = Vec::new();
+    for _ in 0..n_sources {
+        let inserted = d.u32().map_err(corrupt)?;
+        let pending = if d.u8().map_err(corrupt)? == 1 { Some([d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?]) } else { None };
+        sources.push(SourceState { inserted, pending });
+    }
+    let n = d.u64().map_err(corrupt)? as usize;
+    let mut p = Particles::default();
+    for k in 0..GEAR_VALUES {
+        for _ in 0..n {
+            p.q[k].push([d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?]);
+        }
+    }
+    for col in [&mut p.radius, &mut p.mass, &mut p.inertia] {
+        for _ in 0..n {
+            col.push(d.f64().map_err(corrupt)?);
+        }
+    }
+    for _ in 0..n {
+        p.fixed.push(d.u8().map_err(corrupt)? == 1);
+    }
+    for _ in 0..n {
+        p.active.push(d.u8().map_err(corrupt)? == 1);
+    }
+    for _ in 0..n {
+        p.material.push(d.u32().map_err(corrupt)?);
+    }
+    let cap = d.u64().map_err(corrupt)? as usize;
+    let mut springs = SpringTable { keys: Vec::with_capacity(cap), values: Vec::with_capacity(cap) };
+    for _ in 0..cap {
+        springs.keys.push(d.u64().map_err(corrupt)?);
+    }
+    for _ in 0..cap {
+        springs.values.push(d.f64().map_err(corrupt)?);
+    }
+    if !d.is_done() || !cap.is_power_of_two() {
+        return Err(corrupt(crate::files::DecodeError(bytes.len())));
+    }
+    Simulation::from_parts(scene, p, springs, sources, rng, step, lost).map_err(|e| CheckpointError::Scene(name, e))
+}

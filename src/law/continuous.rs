@@ -1,0 +1,192 @@
+//! Continuous interaction with tapered friction for disks, paper 001 eq. 3–8 (SPEC 2.2),
+//! and its equivalent Hooke law (paper 001 eq. 14).
+//!
+//! Lengths enter through σ = (d1 + d2)/2 and forces through m g with m = 2 m12, so the
+//! law is the paper's reduced-unit law for any units and for unequal disks.
+
+use super::spring_dashpot::{non_negative, positive};
+use super::tangential::{tapered_energy, tapered_friction, tapered_stiffness};
+use super::{ContactInput, ContactOutput, clamp_non_negative};
+use crate::scene::{ContinuousSpec, HookeEquivalentSpec, SceneError};
+
+/// The elastic part of the normal force.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Elastic {
+    /// F_e = m g (σ/r)^(n+1) for r < r0 σ (paper 001 sec. II).
+    Power { n: f64 },
+    /// F_e = k (m g/σ)(σ − r) for r < σ; k in units of m g/σ (paper 001 eq. 14).
+    Hooke { k: f64 },
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Continuous {
+    pub elastic: Elastic,
+    /// Cut-off r0/σ of the power law (and the engagement distance for δ_N).
+    pub r0: f64,
+    pub mu: f64,
+    pub alpha: f64,
+    pub damping_fraction: f64,
+    /// Force scale g.
+    pub g: f64,
+}
+
+impl Continuous {
+    pub fn from_spec(s: &ContinuousSpec, g: f64) -> Result<Self, SceneError> {
+        positive("contact.n", s.n)?;
+        if !(s.r0 > 1.0 && s.r0.is_finite()) {
+            return Err(SceneError::invalid("contact.r0", format!("must be greater than 1 (in units of σ), got {}", s.r0)));
+        }
+        let g = force_scale(s.g, g)?;
+        check_friction(s.mu, s.alpha, s.damping_fraction)?;
+        Ok(Self { elastic: Elastic::Power { n: s.n }, r0: s.r0, mu: s.mu, alpha: s.alpha, damping_fraction: s.damping_fraction, g })
+    }
+
+    pub fn from_hooke_spec(s: &HookeEquivalentSpec, g: f64) -> Result<Self, SceneError> {
+        positive("contact.n", s.n)?;
+        if !(s.r0 > 1.0 && s.r0.is_finite()) {
+            return Err(SceneError::invalid("contact.r0", format!("must be greater than 1, got {}", s.r0)));
+        }
+        let k = match s.k {
+            Some(k) => positive("contact.k", k)?,
+            None => {
+                if !(s.r_i > 0.0 && s.r_i < 1.0) {
+                    return Err(SceneError::invalid("contact.r_i", format!("must be in (0, 1) (units of σ), got {}", s.r_i)));
+                }
+                equivalent_hooke_constant(s.n, s.r0, s.r_i)
+            }
+        };
+        let g = force_scale(s.g, g)?;
+        check_friction(s.mu, s.alpha, s.damping_fraction)?;
+        // The Hooke law engages at r = σ: range and δ_N use r0 = 1.
+        Ok(Self { elastic: Elastic::Hooke { k }, r0: 1.0, mu: s.mu, alpha: s.alpha, damping_fraction: s.damping_fraction, g })
+    }
+
+    pub fn range_factor(&self) -> f64 {
+        self.r0
+    }
+
+    pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
+        let m = c.mass;
+        let f_e = self.elastic_force(m, c.sigma, c.r);
+        let k = self.elastic_stiffness(m, c.sigma, c.r);
+        // Paper 001 eq. 3: C_N = 50 % of critical damping 2 sqrt(m k(r)).
+        let c_n = self.damping_fraction * 2.0 * (m * k).sqrt();
+        let f_n = clamp_non_negative(f_e + c_n * c.delta_dot);
+
+        // δ_N = r0 − r; δ_max = α μ δ_N (paper 001 after eq. 6).
+        let delta_n = (self.r0 * c.sigma - c.r).max(0.0);
+        let delta_max = self.alpha * self.mu * delta_n;
+        // Eq. 6: δ_F accumulates the tangential relative velocity at the contact point
+        // (rolling of both disks included in v_t). It is held at ±δ_max while sliding so
+        // that a reversal starts from the Coulomb limit rather than unwinding a long
+        // excursion (the paper leaves this open).
+        let delta_f = (c.history + c.v_t * c.dt).clamp(-delta_max, delta_max);
+        let mu_f_e = self.mu * f_e;
+        let spring = tapered_friction(delta_f, delta_max, mu_f_e);
+        let k_t = tapered_stiffness(delta_f, delta_max, mu_f_e);
+        // Eq. 8: C_T = 50 % of critical, sqrt(m k_T).
+        let c_t = self.damping_fraction * 2.0 * (m * k_t).sqrt();
+        let f_t = -spring.copysign(delta_f) - c_t * c.v_t;
+        let f_t = if delta_f == 0.0 { -c_t * c.v_t } else { f_t };
+
+        let energy = self.elastic_energy(m, c.sigma, c.r) + tapered_energy(delta_f, delta_max, mu_f_e);
+        ContactOutput { f_n, f_t, history: delta_f, energy }
+    }
+
+    /// F_e(r), zero beyond the range.
+    pub fn elastic_force(&self, m: f64, sigma: f64, r: f64) -> f64 {
+        match self.elastic {
+            Elastic::Power { n } if r < self.r0 * sigma => m * self.g * (sigma / r).powf(n + 1.0),
+            Elastic::Hooke { k } if r < sigma => k * m * self.g / sigma * (sigma - r),
+            _ => 0.0,
+        }
+    }
+
+    /// k(r) = −dF_e/dr.
+    pub fn elastic_stiffness(&self, m: f64, sigma: f64, r: f64) -> f64 {
+        match self.elastic {
+            Elastic::Power { n } if r < self.r0 * sigma => (n + 1.0) * m * self.g / sigma * (sigma / r).powf(n + 2.0),
+            Elastic::Hooke { k } if r < sigma => k * m * self.g / sigma,
+            _ => 0.0,
+        }
+    }
+
+    /// Work stored, ∫_r^{range} F_e.
+    pub fn elastic_energy(&self, m: f64, sigma: f64, r: f64) -> f64 {
+        match self.elastic {
+            Elastic::Power { n } if r < self.r0 * sigma => {
+                m * self.g * sigma / n * ((sigma / r).powf(n) - (1.0 / self.r0).powf(n))
+            }
+            Elastic::Hooke { k } if r < sigma => 0.5 * k * m * self.g / sigma * (sigma - r) * (sigma - r),
+            _ => 0.0,
+        }
+    }
+
+    /// ω0² at r = σ, where a resting pair sits under its own weight (paper 001 sec. II).
+    pub fn omega0_squared(&self, m12: f64, sigma: f64) -> f64 {
+        self.elastic_stiffness(2.0 * m12, sigma, sigma) / m12
+    }
+}
+
+/// Paper 001 eq. 14, in units of m g/σ: k = 2 ∫_{r_i}^{r0} F dr / (σ − r_i)², with
+/// ∫ (1/r)^(n+1) dr = (r_i^−n − r0^−n)/n (σ = 1).
+pub fn equivalent_hooke_constant(n: f64, r0: f64, r_i: f64) -> f64 {
+    2.0 * (r_i.powf(-n) - r0.powf(-n)) / n / ((1.0 - r_i) * (1.0 - r_i))
+}
+
+fn force_scale(given: Option<f64>, gravity: f64) -> Result<f64, SceneError> {
+    match given {
+        Some(g) => positive("contact.g", g),
+        None if gravity > 0.0 => Ok(gravity),
+        None => Err(SceneError::invalid("contact.g", "is required when gravity is zero (it sets the force scale m g)")),
+    }
+}
+
+fn check_friction(mu: f64, alpha: f64, damping: f64) -> Result<(), SceneError> {
+    non_negative("contact.mu", mu)?;
+    positive("contact.alpha", alpha)?;
+    non_negative("contact.damping_fraction", damping)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn law() -> Continuous {
+        Continuous { elastic: Elastic::Power { n: 36.0 }, r0: 1.2, mu: 0.5, alpha: 1.214, damping_fraction: 0.5, g: 1.0 }
+    }
+
+    #[test]
+    fn force_is_m_g_at_contact_and_about_a_thousandth_at_cutoff() {
+        let l = law();
+        assert!((l.elastic_force(1.0, 1.0, 1.0) - 1.0).abs() < 1e-15);
+        let cut = l.elastic_force(1.0, 1.0, 1.2 - 1e-12);
+        assert!((cut / 1.2e-3 - 1.0).abs() < 0.05, "cut-off force {cut}"); // SPEC 2.2: ≈1.2e-3 mg
+        assert_eq!(l.elastic_force(1.0, 1.0, 1.2), 0.0);
+    }
+
+    #[test]
+    fn stiffness_and_energy_are_derivatives() {
+        let l = law();
+        let (m, s, r, h) = (1.3, 0.9, 0.95, 1e-7);
+        let dfdr = (l.elastic_force(m, s, r + h) - l.elastic_force(m, s, r - h)) / (2.0 * h);
+        assert!((-dfdr - l.elastic_stiffness(m, s, r)).abs() < 1e-6 * dfdr.abs());
+        let dedr = (l.elastic_energy(m, s, r + h) - l.elastic_energy(m, s, r - h)) / (2.0 * h);
+        assert!((-dedr - l.elastic_force(m, s, r)).abs() < 1e-6);
+    }
+
+    #[test]
+    fn equivalent_hooke_constant_equates_work() {
+        let (n, r0, ri) = (36.0, 1.2, 0.915);
+        let k = equivalent_hooke_constant(n, r0, ri);
+        // trapezoid integral of the power law from r_i to r0
+        let steps = 200_000;
+        let h = (r0 - ri) / steps as f64;
+        let w: f64 = (0..steps).map(|i| {
+            let a = ri + i as f64 * h;
+            0.5 * h * (a.powf(-37.0) + (a + h).powf(-37.0))
+        }).sum();
+        assert!((0.5 * k * (1.0 - ri) * (1.0 - ri) - w).abs() < 1e-6 * w);
+    }
+}

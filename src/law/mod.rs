@@ -1,0 +1,114 @@
+//! Contact laws, assembled from parts (STYLE 3): geometry once per contact, then a normal
+//! law, its damping, the non-negative clamp, and a tangential law with its cap.
+//!
+//! [`ContactLaw`] holds coefficients computed once on the host in f64 from the scene
+//! ([`ContactLaw::from_spec`]); [`ContactLaw::evaluate`] is the per-contact pure function
+//! that the force stage calls. Each formula lives in a small module with the paper's
+//! equation next to it, so a WGSL twin can be written line for line.
+
+pub mod continuous;
+pub mod spring_dashpot;
+pub mod tangential;
+
+use crate::scene::{ContactSpec, SceneError};
+
+/// What the force stage knows about one contact before applying a law.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactInput {
+    /// Geometric overlap δ (SPEC 2.1): (d1 + d2)/2 − r for disks, R − distance for walls.
+    pub delta: f64,
+    /// Centre distance r and mean diameter σ seen by the continuous law (paper 001); for
+    /// a wall the mirror image: r = 2·distance, σ = d.
+    pub r: f64,
+    pub sigma: f64,
+    /// Rate of overlap dδ/dt = −v12·n.
+    pub delta_dot: f64,
+    /// Tangential relative velocity at the contact point, v12·t.
+    pub v_t: f64,
+    /// Reduced mass m12 = m1 m2 / (m1 + m2) (m1 for a wall).
+    pub m12: f64,
+    /// Mass scale m of the continuous law: 2 m12 for two disks (the particle mass for
+    /// equal disks, SPEC 2.2), m1 for a wall (the mirror disk's mass).
+    pub mass: f64,
+    /// Tangential history (spring ξ or paper 001's δ_F) from the previous step.
+    pub history: f64,
+    pub dt: f64,
+}
+
+/// What a law returns for one contact: forces on particle 1 along n and t.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactOutput {
+    pub f_n: f64,
+    pub f_t: f64,
+    /// Updated tangential history to store for the next step.
+    pub history: f64,
+    /// Elastic energy stored in the contact (normal + tangential).
+    pub energy: f64,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum ContactLaw {
+    SpringDashpot(spring_dashpot::SpringDashpot),
+    Continuous(continuous::Continuous),
+}
+
+impl ContactLaw {
+    /// Turns the scene's contact block into coefficients, checking each parameter.
+    /// `g` is |gravity|, the default force scale of the continuous laws.
+    pub fn from_spec(spec: &ContactSpec, g: f64) -> Result<Self, SceneError> {
+        match spec {
+            ContactSpec::SpringDashpot(s) => {
+                Ok(Self::SpringDashpot(spring_dashpot::SpringDashpot::from_spec(s)?))
+            }
+            ContactSpec::Continuous(s) => {
+                Ok(Self::Continuous(continuous::Continuous::from_spec(s, g)?))
+            }
+            ContactSpec::HookeEquivalent(s) => {
+                Ok(Self::Continuous(continuous::Continuous::from_hooke_spec(s, g)?))
+            }
+        }
+    }
+
+    /// Largest centre distance, in units of σ = (d1 + d2)/2, at which two disks interact.
+    pub fn range_factor(&self) -> f64 {
+        match self {
+            Self::SpringDashpot(_) => 1.0,
+            Self::Continuous(c) => c.range_factor(),
+        }
+    }
+
+    /// Whether a contact with this input interacts at all (it then has a history entry).
+    pub fn in_contact(&self, input_r: f64, sigma: f64) -> bool {
+        input_r < self.range_factor() * sigma
+    }
+
+    pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
+        match self {
+            Self::SpringDashpot(l) => l.evaluate(c),
+            Self::Continuous(l) => l.evaluate(c),
+        }
+    }
+
+    /// Stiffness scale k/m12 of the stiffest contact expected, for the time-step check:
+    /// returns ω0² for a contact of two particles with reduced mass m12 and diameter σ.
+    pub fn omega0_squared(&self, m12: f64, sigma: f64) -> f64 {
+        match self {
+            Self::SpringDashpot(l) => l.omega0_squared(m12, sigma),
+            Self::Continuous(l) => l.omega0_squared(m12, sigma),
+        }
+    }
+
+    pub fn mu(&self) -> f64 {
+        match self {
+            Self::SpringDashpot(l) => l.mu,
+            Self::Continuous(l) => l.mu,
+        }
+    }
+}
+
+/// Clamps a normal force to be non-negative: a non-cohesive contact never attracts
+/// (SPEC 2). Applied after damping is added, so a fast-separating contact carries zero
+/// force instead of pulling the grains together.
+pub fn clamp_non_negative(f_n: f64) -> f64 {
+    f_n.max(0.0)
+}

@@ -1,0 +1,24 @@
+//! talus: 2D granular dynamics (DEM) of disks, with a CPU reference path in f64.
+//!
+//! The step is a sequence of stages (see ARCHITECTURE.md): predict → cell list
+//! (`cell_index`, `cell_histogram`, `prefix_sum`, `scatter`) → `find_contacts` →
+//! `gather_history` → `contact_forces` → `store_history` → `reduce_forces` → correct →
+//! boundaries. Scenes are JSON files (`scene`), runs are driven by `run`.
+
+pub mod cell_list;
+pub mod checkpoint;
+pub mod files;
+pub mod contacts;
+pub mod create;
+pub mod forces;
+pub mod geometry;
+pub mod integrate;
+pub mod law;
+pub mod snapshot;
+pub mod progress;
+pub mod rng;
+pub mod run;
+pub mod scene;
+pub mod sim;
+pub mod springs;
+pub mod state;

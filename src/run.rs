@@ -1,0 +1,182 @@
+//! Driving a run: the step loop with outputs (snapshots, checkpoints, energy log), the
+//! settling rule, progress and divergence handling. Everything in the output folder is
+//! written atomically; `summary.json` is written last and marks a complete run.
+
+use crate::files::write_atomic;
+use crate::progress::Progress;
+use crate::sim::{Divergence, Simulation};
+use crate::{checkpoint, snapshot};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// How many checkpoint files are kept (older ones are deleted).
+const KEEP_CHECKPOINTS: usize = 3;
+
+#[derive(Clone, Debug)]
+pub struct RunOptions {
+    pub out: PathBuf,
+    pub quiet: bool,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    pub scene: String,
+    pub backend: String,
+    pub steps: u64,
+    pub time: f64,
+    pub particles: usize,
+    pub mobile: usize,
+    pub lost: u64,
+    /// Whether the run ended by the settling rule (else at stop.time).
+    pub settled: bool,
+    pub kinetic_energy: f64,
+    pub elastic_energy: f64,
+    pub wall_seconds: f64,
+    pub particle_steps_per_second: f64,
+    pub final_snapshot: String,
+    pub last_checkpoint: Option<String>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error("cannot write {path}: {source}")]
+    Io { path: String, source: std::io::Error },
+    #[error("run diverged at step {step} (t = {time:.6e}): {cause}; {checkpoint}")]
+    Diverged { step: u64, time: f64, cause: Divergence, checkpoint: String },
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
+    move |source| RunError::Io { path: path.display().to_string(), source }
+}
+
+/// Steps between events that happen every `interval` of simulated time (0 = never).
+fn every(interval: f64, dt: f64) -> Option<u64> {
+    (interval > 0.0).then(|| ((interval / dt).round() as u64).max(1))
+}
+
+/// The step at which the run ends at the latest.
+pub fn total_steps(sim: &Simulation) -> u64 {
+    (sim.scene.stop.time / sim.dt() - 1e-9).ceil() as u64
+}
+
+pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunError> {
+    let out = &opts.out;
+    std::fs::create_dir_all(out).map_err(io(out))?;
+    let scene_path = out.join("scene.json");
+    let text = serde_json::to_string_pretty(&sim.scene).expect("a scene always serialises");
+    write_atomic(&scene_path, text.as_bytes()).map_err(io(&scene_path))?;
+
+    let dt = sim.dt();
+    let o = sim.scene.output.clone();
+    let snap_every = every(o.snapshot_every, dt);
+    let ckpt_every = every(o.checkpoint_every.unwrap_or(0.1 * sim.scene.stop.time), dt);
+    let log_every = every(if o.log_every > 0.0 { o.log_every } else { sim.scene.stop.time / 200.0 }, dt);
+    let check_every = every(sim.scene.stop.check_every, dt).unwrap_or(1);
+    let total = total_steps(sim);
+    let snap_dir = out.join("snapshots");
+    let ckpt_dir = out.join("checkpoints");
+
+    let mut progress = Progress::new(sim.step, total, opts.quiet);
+    let start = Instant::now();
+    let start_step = sim.step;
+    let mut particle_steps = 0u64;
+    let mut log = String::from("step,time,particles,contacts,kinetic_translational,kinetic_rotational,elastic,potential\n");
+    let mut checkpoints: Vec<PathBuf> = Vec::new();
+    let mut settled = false;
+    if sim.step == 0 && snap_every.is_some() {
+        let p = snapshot::write(sim, &snap_dir, &format!("snap_{:010}", 0)).map_err(io(&snap_dir))?;
+        let _ = p;
+    }
+
+    while sim.step < total {
+        let active = sim.particles.active_count() as u64;
+        if let Err(cause) = sim.step() {
+            progress.finish();
+            let checkpoint = match checkpoints.last() {
+                Some(p) => format!("last good checkpoint: {} (continue with `talus run --resume {}`)", p.display(), p.display()),
+                None => "no checkpoint was written before the divergence (see output.checkpoint_every)".into(),
+            };
+            return Err(RunError::Diverged { step: sim.step, time: sim.time(), cause, checkpoint });
+        }
+        particle_steps += active;
+        let step = sim.step;
+        if log_every.is_some_and(|k| step % k == 0) {
+            let e = sim.energies();
+            log.push_str(&format!(
+                "{step},{:.9e},{},{},{:.9e},{:.9e},{:.9e},{:.9e}\n",
+                sim.time(),
+                sim.particles.active_count(),
+                sim.pairs.len(),
+                e.kinetic_translational,
+                e.kinetic_rotational,
+                e.elastic,
+                e.potential
+            ));
+        }
+        if snap_every.is_some_and(|k| step % k == 0) {
+            snapshot::write(sim, &snap_dir, &format!("snap_{step:010}")).map_err(io(&snap_dir))?;
+        }
+        if ckpt_every.is_some_and(|k| step % k == 0) {
+            write_checkpoint(sim, &ckpt_dir, &mut checkpoints)?;
+            let log_path = out.join("log.csv");
+            write_atomic(&log_path, log.as_bytes()).map_err(io(&log_path))?;
+        }
+        if step % check_every == 0 {
+            progress.update(step, sim.time(), sim.particles.active_count());
+            if let Some(frac) = sim.scene.stop.kinetic_fraction {
+                if sim.time() >= sim.scene.stop.not_before && sim.feeding_done() {
+                    let e = sim.energies();
+                    if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
+                        progress.note(&format!("settled at t = {:.4}: kinetic/elastic = {:.3e}", sim.time(), e.kinetic() / e.elastic));
+                        settled = true;
+                        break;
+                    }
+                }
+            }
+        } else if step % 256 == 0 {
+            progress.update(step, sim.time(), sim.particles.active_count());
+        }
+    }
+    progress.finish();
+
+    if checkpoints.last().is_none_or(|p| !p.ends_with(format!("ckpt_{:010}.bin", sim.step))) && ckpt_every.is_some() {
+        write_checkpoint(sim, &ckpt_dir, &mut checkpoints)?;
+    }
+    let log_path = out.join("log.csv");
+    write_atomic(&log_path, log.as_bytes()).map_err(io(&log_path))?;
+    let final_json = snapshot::write(sim, out, "final").map_err(io(out))?;
+    let wall = start.elapsed().as_secs_f64();
+    let e = sim.energies();
+    let summary = RunSummary {
+        scene: sim.scene.name.clone(),
+        backend: "cpu".into(),
+        steps: sim.step - start_step,
+        time: sim.time(),
+        particles: sim.particles.active_count(),
+        mobile: sim.particles.mobile_count(),
+        lost: sim.lost,
+        settled,
+        kinetic_energy: e.kinetic(),
+        elastic_energy: e.elastic,
+        wall_seconds: wall,
+        particle_steps_per_second: particle_steps as f64 / wall.max(1e-9),
+        final_snapshot: final_json.display().to_string(),
+        last_checkpoint: checkpoints.last().map(|p| p.display().to_string()),
+    };
+    let summary_path = out.join("summary.json");
+    let text = serde_json::to_string_pretty(&summary).expect("summary serialises");
+    write_atomic(&summary_path, text.as_bytes()).map_err(io(&summary_path))?;
+    Ok(summary)
+}
+
+fn write_checkpoint(sim: &Simulation, dir: &Path, written: &mut Vec<PathBuf>) -> Result<(), RunError> {
+    let path = dir.join(format!("ckpt_{:010}.bin", sim.step));
+    checkpoint::write(sim, &path).map_err(io(&path))?;
+    written.push(path);
+    while written.len() > KEEP_CHECKPOINTS {
+        let old = written.remove(0);
+        let _ = std::fs::remove_file(old);
+    }
+    Ok(())
+}

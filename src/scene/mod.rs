@@ -1,0 +1,71 @@
+//! The scene: everything a run needs, parsed strictly from JSON and validated once.
+//!
+//! Parsing (`load`/`parse`) turns text into a [`Scene`]; unknown keys and wrong types are
+//! errors naming the key path (serde + serde_path_to_error). [`validate`] then checks
+//! values (positive radii, known materials, a time step the stiffness allows) and names
+//! the offending key too. Nothing downstream re-checks user input.
+
+mod overrides;
+mod schema;
+mod validate;
+
+pub use overrides::apply_override;
+pub use schema::*;
+pub use validate::{max_diameter, shortest_contact_time, validate};
+
+/// Non-fatal remarks about a valid scene (e.g. dt above t_c/10).
+pub fn warnings(scene: &Scene) -> Vec<String> {
+    validate(scene).unwrap_or_default()
+}
+
+use std::path::Path;
+
+/// The built-in default scene: a small point-source heap of disks (`talus run`).
+pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default_heap.json");
+
+/// A problem with a scene, always naming the key path it concerns.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("cannot read scene file {file}: {reason}")]
+    Io { file: String, reason: String },
+    #[error("scene is not valid JSON: {0}")]
+    Syntax(String),
+    #[error("{path}: {reason}")]
+    Invalid { path: String, reason: String },
+}
+
+impl SceneError {
+    pub fn invalid(path: impl Into<String>, reason: impl Into<String>) -> Self {
+        Self::Invalid { path: path.into(), reason: reason.into() }
+    }
+}
+
+/// Reads a scene file, applies `--set` overrides, parses strictly and validates.
+pub fn load(path: &Path, overrides: &[String]) -> Result<Scene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
+        file: path.display().to_string(),
+        reason: e.to_string(),
+    })?;
+    parse(&text, overrides)
+}
+
+/// Parses scene text (JSON), applies `path=value` overrides, and validates the result.
+pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
+    let mut value: serde_json::Value =
+        serde_json::from_str(text).map_err(|e| SceneError::Syntax(e.to_string()))?;
+    for o in overrides {
+        apply_override(&mut value, o)?;
+    }
+    let scene = from_value(value)?;
+    validate(&scene)?;
+    Ok(scene)
+}
+
+/// Strict typed parse of a JSON value; errors carry the key path.
+pub fn from_value(value: serde_json::Value) -> Result<Scene, SceneError> {
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let path = e.path().to_string();
+        let path = if path == "." { "scene".to_string() } else { path };
+        SceneError::invalid(path, e.into_inner().to_string())
+    })
+}

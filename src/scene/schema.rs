@@ -1,0 +1,384 @@
+//! The scene's data model: the JSON keys, their types and their defaults (SPEC 4).
+//!
+//! Every struct denies unknown keys. Lengths, times and masses are in the scene's units;
+//! `units` only labels them ("si" or "reduced", paper 001's σ, m, g).
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    #[serde(default = "default_name")]
+    pub name: String,
+    #[serde(default)]
+    pub units: Units,
+    #[serde(default)]
+    pub seed: u64,
+    /// Time step.
+    pub dt: f64,
+    pub stop: Stop,
+    #[serde(default)]
+    pub integrator: IntegratorKind,
+    pub gravity: Gravity,
+    pub domain: Domain,
+    pub materials: BTreeMap<String, Material>,
+    pub contact: ContactSpec,
+    #[serde(default)]
+    pub walls: Vec<Wall>,
+    pub particles: Vec<Creation>,
+    #[serde(default)]
+    pub output: Output,
+    #[serde(default)]
+    pub limits: Limits,
+}
+
+fn default_name() -> String {
+    "unnamed".into()
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Units {
+    Si,
+    #[default]
+    Reduced,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IntegratorKind {
+    /// 5th-order Gear predictor–corrector, six values (SPEC 3).
+    #[default]
+    Gear5,
+    /// Leapfrog with half-step velocities (paper 001 eq. 9–12).
+    Leapfrog,
+}
+
+/// When the run ends: at `time`, or earlier once it has settled.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stop {
+    /// End time (always applies).
+    pub time: f64,
+    /// Stop early when kinetic energy < this fraction of the elastic energy (paper 000
+    /// sec. 3: "kinetic energy orders of magnitude smaller than the elastic energy").
+    #[serde(default)]
+    pub kinetic_fraction: Option<f64>,
+    /// Simulated time between checks of the settling rule.
+    #[serde(default = "default_check_every")]
+    pub check_every: f64,
+    /// The settling rule is not checked before this time (nor while sources still pour
+    /// or gravity still ramps).
+    #[serde(default)]
+    pub not_before: f64,
+}
+
+fn default_check_every() -> f64 {
+    1.0
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gravity {
+    /// Acceleration vector (x, z).
+    pub g: [f64; 2],
+    /// Gravity grows linearly from zero to `g` over this time (paper 000 sec. 4).
+    #[serde(default)]
+    pub ramp_time: f64,
+}
+
+/// The simulation box. Particles whose centre leaves it are removed and counted as lost.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Domain {
+    pub x: [f64; 2],
+    pub z: [f64; 2],
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Material {
+    /// Mass density; mass = density · area · thickness (SPEC 1).
+    pub density: f64,
+    /// Extent along the third axis (2D particles are rods; 1 m in paper 000).
+    #[serde(default = "one")]
+    pub thickness: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// The contact law between all particles and walls (SPEC 2.1, 2.2).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(tag = "law", rename_all = "snake_case")]
+pub enum ContactSpec {
+    SpringDashpot(SpringDashpotSpec),
+    Continuous(ContinuousSpec),
+    HookeEquivalent(HookeEquivalentSpec),
+}
+
+/// Power-law spring-dashpot, paper 000 eq. 2–5.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpringDashpotSpec {
+    /// Normal stiffness k_n (force/length for ν = 1).
+    pub k_n: f64,
+    /// Elastic exponent ν: 1 Hooke, 1.5 Hertz, 2 conical.
+    #[serde(default = "one")]
+    pub nu: f64,
+    /// Damping exponent ψ.
+    #[serde(default)]
+    pub psi: f64,
+    /// Normalisation length δ0; required when ν ≠ 1 or ψ ≠ 0.
+    #[serde(default)]
+    pub delta0: Option<f64>,
+    /// Normal damping γ_n (mass/time).
+    #[serde(default)]
+    pub gamma_n: f64,
+    /// Tangential stiffness k_t; 0 disables the tangential spring.
+    #[serde(default)]
+    pub k_t: f64,
+    /// Tangential damping γ_t.
+    #[serde(default)]
+    pub gamma_t: f64,
+    /// Coulomb friction coefficient μ.
+    #[serde(default)]
+    pub mu: f64,
+}
+
+/// Continuous r^-(n+1) interaction with tapered friction, paper 001 eq. 3–8.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ContinuousSpec {
+    #[serde(default = "default_n")]
+    pub n: f64,
+    /// Cut-off r0 in units of σ.
+    #[serde(default = "default_r0")]
+    pub r0: f64,
+    #[serde(default)]
+    pub mu: f64,
+    /// δ_max = α μ δ_N (paper 001 after eq. 6).
+    #[serde(default = "default_alpha")]
+    pub alpha: f64,
+    /// Fraction of critical damping (paper 001: 0.5).
+    #[serde(default = "default_damping_fraction")]
+    pub damping_fraction: f64,
+    /// Force scale g in F = m g (σ/r)^(n+1); defaults to |gravity.g|.
+    #[serde(default)]
+    pub g: Option<f64>,
+}
+
+/// Hooke law equivalent to the continuous one by equal work (paper 001 eq. 14).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HookeEquivalentSpec {
+    #[serde(default = "default_n")]
+    pub n: f64,
+    #[serde(default = "default_r0")]
+    pub r0: f64,
+    /// Minimum separation r_i / σ observed in the continuous run (paper 001 Fig. 4: 0.915).
+    #[serde(default = "default_r_i")]
+    pub r_i: f64,
+    /// Spring constant in units of m g / σ; overrides the value from r_i when given.
+    #[serde(default)]
+    pub k: Option<f64>,
+    #[serde(default)]
+    pub mu: f64,
+    #[serde(default = "default_alpha")]
+    pub alpha: f64,
+    #[serde(default = "default_damping_fraction")]
+    pub damping_fraction: f64,
+    #[serde(default)]
+    pub g: Option<f64>,
+}
+
+fn default_n() -> f64 {
+    36.0
+}
+fn default_r0() -> f64 {
+    1.2
+}
+fn default_r_i() -> f64 {
+    0.915
+}
+fn default_alpha() -> f64 {
+    1.214
+}
+fn default_damping_fraction() -> f64 {
+    0.5
+}
+
+/// A fixed straight wall segment.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Wall {
+    pub from: [f64; 2],
+    pub to: [f64; 2],
+}
+
+/// A size: a fixed diameter or a uniform distribution of diameters.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Size {
+    Fixed(f64),
+    Uniform(UniformSize),
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UniformSize {
+    pub uniform: [f64; 2],
+}
+
+impl Size {
+    pub fn bounds(&self) -> (f64, f64) {
+        match self {
+            Size::Fixed(d) => (*d, *d),
+            Size::Uniform(u) => (u.uniform[0], u.uniform[1]),
+        }
+    }
+}
+
+/// How particles are created (SPEC 4).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Creation {
+    LatticePile(LatticePile),
+    Row(Row),
+    PointSource(PointSource),
+    List(ParticleList),
+}
+
+/// A triangular-lattice pile (paper 000 sec. 4, Fig. 2): row M holds L − M (60°) or
+/// L − 3M (30°) disks.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LatticePile {
+    pub material: String,
+    /// 30 or 60 degrees.
+    pub slope: f64,
+    /// L, the number of disks in the bottom row M = 0.
+    pub bottom_row: u32,
+    /// d0.
+    pub diameter: f64,
+    /// c in the bottom-row spacing d0 (1 + c) (paper 000 sec. 4.1).
+    #[serde(default)]
+    pub spacing_c: f64,
+    /// r_d: mobile diameters d0 (1 + u), u uniform in [−r_d/2, r_d/2] (paper 000 sec. 4.4).
+    #[serde(default)]
+    pub size_disorder: f64,
+    /// Whether the bottom row is fixed (a bumpy base).
+    #[serde(default = "yes")]
+    pub fixed_bottom: bool,
+    /// x of the pile's centre line.
+    #[serde(default)]
+    pub center_x: f64,
+    /// z of the bottom of the lowest row.
+    #[serde(default)]
+    pub base_z: f64,
+}
+
+fn yes() -> bool {
+    true
+}
+
+/// A straight horizontal row of equal disks, e.g. a bumpy substrate (paper 001).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Row {
+    pub material: String,
+    pub count: u32,
+    pub diameter: f64,
+    /// Centre-to-centre spacing.
+    pub spacing: f64,
+    /// Centre of the first disk.
+    pub start: [f64; 2],
+    #[serde(default = "yes")]
+    pub fixed: bool,
+}
+
+/// A point source pouring disks (paper 001 sec. II; paper 000 sec. 5.3).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointSource {
+    pub material: String,
+    /// Outlet position (x, z); z is the drop height.
+    pub position: [f64; 2],
+    /// x is drawn uniformly in ±spread around the outlet.
+    #[serde(default)]
+    pub spread: f64,
+    /// Particles per unit time.
+    pub rate: f64,
+    /// Total number to pour.
+    pub count: u32,
+    pub diameter: Size,
+    /// Initial velocity (x, z).
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    #[serde(default)]
+    pub start_time: f64,
+}
+
+/// Particles given one by one (small test scenes).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParticleList {
+    pub material: String,
+    pub particles: Vec<ListedParticle>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ListedParticle {
+    pub position: [f64; 2],
+    pub diameter: f64,
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    #[serde(default)]
+    pub theta: f64,
+    #[serde(default)]
+    pub omega: f64,
+    #[serde(default)]
+    pub fixed: bool,
+}
+
+/// What is written and how often (in simulated time; 0 disables).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Output {
+    #[serde(default)]
+    pub snapshot_every: f64,
+    /// Default: a tenth of `stop.time`; 0 disables checkpoints.
+    #[serde(default)]
+    pub checkpoint_every: Option<f64>,
+    /// Interval of the energy log (log.csv).
+    #[serde(default)]
+    pub log_every: f64,
+}
+
+impl Default for Output {
+    fn default() -> Self {
+        Self { snapshot_every: 0.0, checkpoint_every: None, log_every: 0.0 }
+    }
+}
+
+/// Divergence guards.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Limits {
+    /// A run stops when an overlap exceeds this fraction of the smaller radius.
+    #[serde(default = "default_max_overlap")]
+    pub max_overlap: f64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self { max_overlap: default_max_overlap() }
+    }
+}
+
+fn default_max_overlap() -> f64 {
+    0.5
+}

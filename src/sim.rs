@@ -1,0 +1,252 @@
+//! The simulation on the CPU reference path (f64): state, and one time step that reads
+//! like the algorithm. Each stage is a function with a GPU twin of the same name
+//! (ARCHITECTURE.md).
+
+use crate::cell_list::{CellList, Grid};
+use crate::contacts::{Pair, find_contacts};
+use crate::create::{self, source::SourceState};
+use crate::forces::{ContactForce, contact_forces, reduce_forces};
+use crate::geometry::WallSegment;
+use crate::integrate::{gear, leapfrog};
+use crate::law::ContactLaw;
+use crate::rng::Rng;
+use crate::scene::{Creation, IntegratorKind, Scene, SceneError};
+use crate::springs::{SpringTable, gather_history, store_history};
+use crate::state::{Dof, Particles};
+
+/// Why a step could not be completed.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Divergence {
+    #[error("particle {id} has a non-finite {what}")]
+    NotFinite { id: u32, what: &'static str },
+    #[error("particles {i} and {j} overlap by {ratio:.3} of the smaller radius (limits.max_overlap = {limit})")]
+    Overlap { i: u32, j: String, ratio: f64, limit: f64 },
+}
+
+/// Energies at the end of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energies {
+    pub kinetic_translational: f64,
+    pub kinetic_rotational: f64,
+    /// Stored in contacts at the last force evaluation.
+    pub elastic: f64,
+    /// Gravitational potential −m g·r of mobile particles (full g, relative to z = 0).
+    pub potential: f64,
+}
+
+impl Energies {
+    pub fn kinetic(&self) -> f64 {
+        self.kinetic_translational + self.kinetic_rotational
+    }
+}
+
+pub struct Simulation {
+    pub scene: Scene,
+    pub law: ContactLaw,
+    pub walls: Vec<WallSegment>,
+    pub grid: Grid,
+    pub particles: Particles,
+    pub springs: SpringTable,
+    pub sources: Vec<SourceState>,
+    pub rng: Rng,
+    pub step: u64,
+    /// Particles removed for leaving the domain.
+    pub lost: u64,
+    // Per-step buffers, rebuilt every step (not part of the state).
+    pub cells: CellList,
+    pub pairs: Vec<Pair>,
+    pub contacts: Vec<ContactForce>,
+    history_in: Vec<f64>,
+    history_out: Vec<f64>,
+    forces: Vec<Dof>,
+}
+
+impl Simulation {
+    /// Builds the initial state of a validated scene.
+    pub fn new(scene: Scene) -> Result<Self, SceneError> {
+        let mut rng = Rng::new(scene.seed);
+        let particles = create::initial_particles(&scene, &mut rng);
+        let sources = scene.particles.iter().filter(|c| matches!(c, Creation::PointSource(_))).map(|_| SourceState::default()).collect();
+        let mut sim = Self::from_parts(scene, particles, SpringTable::default(), sources, rng, 0, 0)?;
+        // Start Gear with the gravitational acceleration in q2 so free flight is exact
+        // from the first step.
+        let g = sim.gravity(0.0);
+        for i in 0..sim.particles.len() {
+            sim.seed_acceleration(i, g);
+        }
+        Ok(sim)
+    }
+
+    /// Reassembles a simulation from its state (used by `new` and by checkpoints).
+    pub fn from_parts(
+        scene: Scene,
+        particles: Particles,
+        springs: SpringTable,
+        sources: Vec<SourceState>,
+        rng: Rng,
+        step: u64,
+        lost: u64,
+    ) -> Result<Self, SceneError> {
+        let g = scene.gravity.g;
+        let law = ContactLaw::from_spec(&scene.contact, (g[0] * g[0] + g[1] * g[1]).sqrt())?;
+        let walls = scene.walls.iter().map(|w| WallSegment { a: w.from, b: w.to }).collect();
+        let max_d = crate::scene::max_diameter(&scene).max(2.0 * particles.max_radius());
+        let grid = Grid::new(scene.domain.x, scene.domain.z, law.range_factor() * max_d);
+        Ok(Self {
+            scene,
+            law,
+            walls,
+            grid,
+            particles,
+            springs,
+            sources,
+            rng,
+            step,
+            lost,
+            cells: CellList::default(),
+            pairs: Vec::new(),
+            contacts: Vec::new(),
+            history_in: Vec::new(),
+            history_out: Vec::new(),
+            forces: Vec::new(),
+        })
+    }
+
+    pub fn dt(&self) -> f64 {
+        self.scene.dt
+    }
+
+    /// Simulated time, computed from the step count so it never drifts.
+    pub fn time(&self) -> f64 {
+        self.step as f64 * self.scene.dt
+    }
+
+    /// Gravity at time t, ramped linearly over `gravity.ramp_time` (paper 000 sec. 4).
+    pub fn gravity(&self, t: f64) -> [f64; 2] {
+        let g = self.scene.gravity.g;
+        let ramp = self.scene.gravity.ramp_time;
+        let s = if ramp > 0.0 { (t / ramp).min(1.0) } else { 1.0 };
+        [g[0] * s, g[1] * s]
+    }
+
+    /// Whether every source has poured all its particles and gravity is at full strength.
+    pub fn feeding_done(&self) -> bool {
+        let specs = self.scene.particles.iter().filter_map(|c| match c {
+            Creation::PointSource(s) => Some(s),
+            _ => None,
+        });
+        specs.zip(&self.sources).all(|(spec, st)| st.done(spec)) && self.time() >= self.scene.gravity.ramp_time
+    }
+
+    fn seed_acceleration(&mut self, i: usize, g: [f64; 2]) {
+        if self.scene.integrator == IntegratorKind::Gear5 && !self.particles.fixed[i] {
+            let h = 0.5 * self.scene.dt * self.scene.dt;
+            self.particles.q[2][i] = [h * g[0], h * g[1], 0.0];
+        }
+    }
+
+    /// One time step: insert, predict, cell list, contacts, springs, forces, reduce,
+    /// correct, boundaries.
+    pub fn step(&mut self) -> Result<(), Divergence> {
+        let dt = self.scene.dt;
+        let t = self.time();
+        self.insert_from_sources(t);
+        let gear = self.scene.integrator == IntegratorKind::Gear5;
+        if gear {
+            gear::predict(&mut self.particles);
+        }
+        self.cells.build(&self.grid, &self.particles.q[0], &self.particles.active);
+        find_contacts(&self.grid, &self.cells, &self.particles, &self.walls, self.law.range_factor(), &mut self.pairs);
+        gather_history(&self.springs, &self.pairs, &mut self.history_in);
+        contact_forces(&self.particles, &self.walls, &self.law, dt, &self.pairs, &self.history_in, &mut self.contacts, &mut self.history_out);
+        self.check_divergence()?;
+        store_history(&self.pairs, &self.history_out, &mut self.springs);
+        reduce_forces(&self.particles, &self.pairs, &self.contacts, &mut self.forces);
+        if gear {
+            // Forces were evaluated at the predicted state, i.e. at time t + dt.
+            let g = self.gravity(t + dt);
+            gear::correct(&mut self.particles, &self.forces, g, dt);
+        } else {
+            let g = self.gravity(t);
+            leapfrog::kick_drift(&mut self.particles, &self.forces, g, dt);
+        }
+        self.remove_escaped();
+        self.step += 1;
+        Ok(())
+    }
+
+    fn insert_from_sources(&mut self, t: f64) {
+        let mut k = 0;
+        for block in &self.scene.particles {
+            let Creation::PointSource(spec) = block else { continue };
+            let material = create::material_index(&self.scene, &spec.material);
+            let disks = create::source::emit(spec, &mut self.sources[k], t, material, &self.particles, &mut self.rng);
+            for d in disks {
+                let id = create::push(&self.scene, &mut self.particles, &d) as usize;
+                let h = 0.5 * self.scene.dt * self.scene.dt;
+                if self.scene.integrator == IntegratorKind::Gear5 {
+                    let g = self.gravity(t);
+                    self.particles.q[2][id] = [h * g[0], h * g[1], 0.0];
+                }
+            }
+            k += 1;
+        }
+    }
+
+    fn check_divergence(&self) -> Result<(), Divergence> {
+        let limit = self.scene.limits.max_overlap;
+        for (pair, c) in self.pairs.iter().zip(&self.contacts) {
+            let ri = self.particles.radius[pair.i as usize];
+            let rmin = if pair.is_wall() { ri } else { ri.min(self.particles.radius[pair.j as usize]) };
+            if !(c.force[0].is_finite() && c.force[1].is_finite()) {
+                return Err(Divergence::NotFinite { id: pair.i, what: "contact force" });
+            }
+            let ratio = c.overlap / rmin;
+            if ratio > limit {
+                let j = if pair.is_wall() { format!("wall {}", pair.j - crate::contacts::WALL_BASE) } else { pair.j.to_string() };
+                return Err(Divergence::Overlap { i: pair.i, j, ratio, limit });
+            }
+        }
+        for i in 0..self.particles.len() {
+            if self.particles.active[i] && !self.particles.q[0][i].iter().all(|v| v.is_finite()) {
+                return Err(Divergence::NotFinite { id: i as u32, what: "position" });
+            }
+        }
+        Ok(())
+    }
+
+    /// Boundary stage: particles whose centre left the domain are removed.
+    fn remove_escaped(&mut self) {
+        let d = &self.scene.domain;
+        for i in 0..self.particles.len() {
+            if !self.particles.active[i] {
+                continue;
+            }
+            let p = self.particles.q[0][i];
+            if p[0] < d.x[0] || p[0] > d.x[1] || p[1] < d.z[0] || p[1] > d.z[1] {
+                self.particles.active[i] = false;
+                self.lost += 1;
+            }
+        }
+    }
+
+    /// Kinetic, elastic and potential energy now.
+    pub fn energies(&self) -> Energies {
+        let dt = self.scene.dt;
+        let g = self.scene.gravity.g;
+        let mut e = Energies::default();
+        for i in 0..self.particles.len() {
+            if !crate::integrate::is_integrated(&self.particles, i) {
+                continue;
+            }
+            let v = self.particles.velocity(i, dt);
+            let m = self.particles.mass[i];
+            e.kinetic_translational += 0.5 * m * (v[0] * v[0] + v[1] * v[1]);
+            e.kinetic_rotational += 0.5 * self.particles.inertia[i] * v[2] * v[2];
+            let p = self.particles.q[0][i];
+            e.potential -= m * (g[0] * p[0] + g[1] * p[1]);
+        }
+        e.elastic = self.contacts.iter().map(|c| c.energy).sum();
+        e
+    }
+}

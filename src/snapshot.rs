@@ -1,0 +1,184 @@
+//! Snapshots: the particles and contacts at one step, as little-endian binary columns
+//! (`NAME.bin`) described by JSON metadata (`NAME.json`). The format is documented in
+//! docs/FORMATS.md; `read` loads it back. The `.bin` is renamed into place before the
+//! `.json`, so metadata never points at missing data.
+
+use crate::contacts::WALL_BASE;
+use crate::files::write_atomic;
+use crate::sim::Simulation;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+pub const FORMAT: &str = "talus-snapshot";
+pub const VERSION: u32 = 1;
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ColumnMeta {
+    /// "particles" or "contacts".
+    pub table: String,
+    pub name: String,
+    /// "f64", "u32" or "u8".
+    pub dtype: String,
+    pub unit: String,
+    /// Byte offset in the .bin file, and the number of values.
+    pub offset: u64,
+    pub count: u64,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct Meta {
+    pub format: String,
+    pub version: u32,
+    pub scene: String,
+    pub units: String,
+    pub step: u64,
+    pub time: f64,
+    pub particles: u64,
+    pub contacts: u64,
+    /// Id used in the contact column `j` for wall w: wall_base + w.
+    pub wall_base: u32,
+    pub data: String,
+    pub columns: Vec<ColumnMeta>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Column {
+    F64(Vec<f64>),
+    U32(Vec<u32>),
+    U8(Vec<u8>),
+}
+
+/// A snapshot read back from disk.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Snapshot {
+    pub meta: Meta,
+    pub columns: BTreeMap<String, Column>,
+}
+
+impl Snapshot {
+    pub fn f64(&self, key: &str) -> Option<&[f64]> {
+        match self.columns.get(key) {
+            Some(Column::F64(v)) => Some(v),
+            _ => None,
+        }
+    }
+    pub fn u32(&self, key: &str) -> Option<&[u32]> {
+        match self.columns.get(key) {
+            Some(Column::U32(v)) => Some(v),
+            _ => None,
+        }
+    }
+}
+
+struct Builder {
+    bytes: Vec<u8>,
+    columns: Vec<ColumnMeta>,
+}
+
+impl Builder {
+    fn push(&mut self, table: &str, name: &str, unit: &str, col: Column) {
+        let offset = self.bytes.len() as u64;
+        let (dtype, count) = match &col {
+            Column::F64(v) => {
+                v.iter().for_each(|x| self.bytes.extend_from_slice(&x.to_le_bytes()));
+                ("f64", v.len())
+            }
+            Column::U32(v) => {
+                v.iter().for_each(|x| self.bytes.extend_from_slice(&x.to_le_bytes()));
+                ("u32", v.len())
+            }
+            Column::U8(v) => {
+                self.bytes.extend_from_slice(v);
+                ("u8", v.len())
+            }
+        };
+        self.columns.push(ColumnMeta { table: table.into(), name: name.into(), dtype: dtype.into(), unit: unit.into(), offset, count: count as u64 });
+    }
+}
+
+/// Writes `DIR/STEM.bin` and `DIR/STEM.json`; returns the JSON path.
+pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBuf> {
+    let p = &sim.particles;
+    let dt = sim.dt();
+    let ids: Vec<usize> = (0..p.len()).filter(|&i| p.active[i]).collect();
+    let f = |g: &dyn Fn(usize) -> f64| Column::F64(ids.iter().map(|&i| g(i)).collect());
+    let (len, time, mass) = match sim.scene.units {
+        crate::scene::Units::Si => ("m", "s", "kg"),
+        crate::scene::Units::Reduced => ("sigma", "sqrt(sigma/g)", "m"),
+    };
+    let vel = format!("{len}/{time}");
+    let force = if sim.scene.units == crate::scene::Units::Si { "N".to_string() } else { "m g".to_string() };
+    let mut b = Builder { bytes: Vec::new(), columns: Vec::new() };
+    b.push("particles", "id", "", Column::U32(ids.iter().map(|&i| i as u32).collect()));
+    b.push("particles", "x", len, f(&|i| p.q[0][i][0]));
+    b.push("particles", "z", len, f(&|i| p.q[0][i][1]));
+    b.push("particles", "theta", "rad", f(&|i| p.q[0][i][2]));
+    b.push("particles", "vx", &vel, f(&|i| p.q[1][i][0] / dt));
+    b.push("particles", "vz", &vel, f(&|i| p.q[1][i][1] / dt));
+    b.push("particles", "omega", &format!("rad/{time}"), f(&|i| p.q[1][i][2] / dt));
+    b.push("particles", "radius", len, f(&|i| p.radius[i]));
+    b.push("particles", "mass", mass, f(&|i| p.mass[i]));
+    b.push("particles", "fixed", "", Column::U8(ids.iter().map(|&i| p.fixed[i] as u8).collect()));
+    b.push("particles", "material", "", Column::U32(ids.iter().map(|&i| p.material[i]).collect()));
+    let c = &sim.contacts;
+    let pairs = &sim.pairs;
+    let cf = |g: &dyn Fn(usize) -> f64| Column::F64((0..c.len()).map(g).collect());
+    b.push("contacts", "i", "", Column::U32(pairs.iter().map(|q| q.i).collect()));
+    b.push("contacts", "j", "", Column::U32(pairs.iter().map(|q| q.j).collect()));
+    b.push("contacts", "nx", "", cf(&|k| c[k].n[0]));
+    b.push("contacts", "nz", "", cf(&|k| c[k].n[1]));
+    b.push("contacts", "fn", &force, cf(&|k| c[k].f_n));
+    b.push("contacts", "ft", &force, cf(&|k| c[k].f_t));
+    b.push("contacts", "px", len, cf(&|k| c[k].point[0]));
+    b.push("contacts", "pz", len, cf(&|k| c[k].point[1]));
+    b.push("contacts", "overlap", len, cf(&|k| c[k].overlap));
+    let meta = Meta {
+        format: FORMAT.into(),
+        version: VERSION,
+        scene: sim.scene.name.clone(),
+        units: format!("{:?}", sim.scene.units).to_lowercase(),
+        step: sim.step,
+        time: sim.time(),
+        particles: ids.len() as u64,
+        contacts: c.len() as u64,
+        wall_base: WALL_BASE,
+        data: format!("{stem}.bin"),
+        columns: b.columns,
+    };
+    write_atomic(&dir.join(format!("{stem}.bin")), &b.bytes)?;
+    let json_path = dir.join(format!("{stem}.json"));
+    let text = serde_json::to_string_pretty(&meta).map_err(std::io::Error::other)?;
+    write_atomic(&json_path, text.as_bytes())?;
+    Ok(json_path)
+}
+
+/// Reads a snapshot from its `.json` path.
+pub fn read(json_path: &Path) -> Result<Snapshot, String> {
+    let text = std::fs::read_to_string(json_path).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    let meta: Meta = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    if meta.format != FORMAT {
+        return Err(format!("{}: not a talus snapshot", json_path.display()));
+    }
+    let bin = json_path.with_file_name(&meta.data);
+    let bytes = std::fs::read(&bin).map_err(|e| format!("{}: {e}", bin.display()))?;
+    let mut columns = BTreeMap::new();
+    for c in &meta.columns {
+        let size = match c.dtype.as_str() {
+            "f64" => 8,
+            "u32" => 4,
+            "u8" => 1,
+            other => return Err(format!("column {}: unknown dtype {other}", c.name)),
+        };
+        let start = c.offset as usize;
+        let end = start + size * c.count as usize;
+        let raw = bytes.get(start..end).ok_or_else(|| format!("column {}.{} runs past the end of {}", c.table, c.name, bin.display()))?;
+        let col = match size {
+            8 => Column::F64(raw.chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap())).collect()),
+            4 => Column::U32(raw.chunks_exact(4).map(|b| u32::from_le_bytes(b.try_into().unwrap())).collect()),
+            _ => Column::U8(raw.to_vec()),
+        };
+        columns.insert(format!("{}.{}", c.table, c.name), col);
+    }
+    Ok(Snapshot { meta, columns })
+}

@@ -1,0 +1,89 @@
+//! Particle state: structure-of-arrays in f64, indexed by particle id (creation order).
+//!
+//! Positions and orientations carry their Gear derivatives: `q[k][i]` holds
+//! (dt^k / k!) d^k(x, z, θ)/dt^k of particle i (Allen & Tildesley's scaled derivatives),
+//! so q[0] is the configuration and q[1]/dt the velocity. Leapfrog keeps
+//! q[1] = dt · v(t − dt/2) and leaves q[2..] at zero. These arrays are the whole dynamic
+//! state; forces are recomputed every step.
+
+/// (x, z, θ) or its derivatives.
+pub type Dof = [f64; 3];
+
+/// Gear order + 1: the number of stored values per degree of freedom.
+pub const GEAR_VALUES: usize = 6;
+
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Particles {
+    pub q: [Vec<Dof>; GEAR_VALUES],
+    pub radius: Vec<f64>,
+    pub mass: Vec<f64>,
+    pub inertia: Vec<f64>,
+    /// Fixed particles take part in contacts but are never integrated (SPEC 1).
+    pub fixed: Vec<bool>,
+    /// Cleared when a particle leaves the domain; its id is never reused.
+    pub active: Vec<bool>,
+    pub material: Vec<u32>,
+}
+
+/// A new disk before it joins the state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct NewDisk {
+    pub position: [f64; 2],
+    pub theta: f64,
+    pub velocity: [f64; 2],
+    pub omega: f64,
+    pub radius: f64,
+    pub fixed: bool,
+    pub material: u32,
+}
+
+impl Particles {
+    pub fn len(&self) -> usize {
+        self.radius.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.radius.is_empty()
+    }
+
+    /// Appends a disk; mass = density · area · thickness, I = m r²/2 (SPEC 1; paper 001's
+    /// I = m σ²/8 for a disk of diameter σ).
+    pub fn push_disk(&mut self, d: &NewDisk, density: f64, thickness: f64, dt: f64) -> u32 {
+        let id = self.len() as u32;
+        let mass = density * std::f64::consts::PI * d.radius * d.radius * thickness;
+        self.q[0].push([d.position[0], d.position[1], d.theta]);
+        self.q[1].push([d.velocity[0] * dt, d.velocity[1] * dt, d.omega * dt]);
+        for k in 2..GEAR_VALUES {
+            self.q[k].push([0.0; 3]);
+        }
+        self.radius.push(d.radius);
+        self.mass.push(mass);
+        self.inertia.push(0.5 * mass * d.radius * d.radius);
+        self.fixed.push(d.fixed);
+        self.active.push(true);
+        self.material.push(d.material);
+        id
+    }
+
+    pub fn position(&self, i: usize) -> [f64; 2] {
+        [self.q[0][i][0], self.q[0][i][1]]
+    }
+
+    /// Velocity (vx, vz, ω) from the scaled first derivative.
+    pub fn velocity(&self, i: usize, dt: f64) -> Dof {
+        let q = self.q[1][i];
+        [q[0] / dt, q[1] / dt, q[2] / dt]
+    }
+
+    pub fn active_count(&self) -> usize {
+        self.active.iter().filter(|a| **a).count()
+    }
+
+    pub fn mobile_count(&self) -> usize {
+        (0..self.len()).filter(|&i| self.active[i] && !self.fixed[i]).count()
+    }
+
+    pub fn max_radius(&self) -> f64 {
+        self.radius.iter().copied().fold(0.0, f64::max)
+    }
+}
