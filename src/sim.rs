@@ -242,7 +242,9 @@ impl Simulation {
             let v = self.particles.velocity(i, dt);
             let m = self.particles.mass[i];
             e.kinetic_translational += 0.5 * m * (v[0] * v[0] + v[1] * v[1]);
-            e.kinetic_rotational += 0.5 * self.particles.inertia[i] * v[2] * v[2];
+            if self.particles.inertia[i].is_finite() {
+                e.kinetic_rotational += 0.5 * self.particles.inertia[i] * v[2] * v[2];
+            }
             let p = self.particles.q[0][i];
             e.potential -= m * (g[0] * p[0] + g[1] * p[1]);
         }

@@ -34,6 +34,8 @@ pub struct NewDisk {
     pub omega: f64,
     pub radius: f64,
     pub fixed: bool,
+    /// Infinite moment of inertia: the particle never turns.
+    pub fixed_rotation: bool,
     pub material: u32,
 }
 
@@ -58,7 +60,7 @@ impl Particles {
         }
         self.radius.push(d.radius);
         self.mass.push(mass);
-        self.inertia.push(0.5 * mass * d.radius * d.radius);
+        self.inertia.push(if d.fixed_rotation { f64::INFINITY } else { 0.5 * mass * d.radius * d.radius });
         self.fixed.push(d.fixed);
         self.active.push(true);
         self.material.push(d.material);

@@ -38,7 +38,7 @@ pub fn pile(p: &LatticePile, material: u32, rng: &mut Rng) -> Vec<NewDisk> {
             } else {
                 d0 * (1.0 + rng.range(-0.5 * p.size_disorder, 0.5 * p.size_disorder))
             };
-            out.push(NewDisk { position: [x, z], theta: 0.0, velocity: [0.0; 2], omega: 0.0, radius: 0.5 * diameter, fixed, material });
+            out.push(NewDisk { position: [x, z], theta: 0.0, velocity: [0.0; 2], omega: 0.0, radius: 0.5 * diameter, fixed, fixed_rotation: false, material });
         }
     }
     out

@@ -41,6 +41,7 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
                         omega: 0.0,
                         radius: 0.5 * r.diameter,
                         fixed: r.fixed,
+                        fixed_rotation: false,
                         material,
                     };
                     push(scene, &mut particles, &d);
@@ -56,6 +57,7 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
                         omega: p.omega,
                         radius: 0.5 * p.diameter,
                         fixed: p.fixed,
+                        fixed_rotation: p.fixed_rotation,
                         material,
                     };
                     push(scene, &mut particles, &d);

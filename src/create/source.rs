@@ -59,7 +59,7 @@ pub fn emit(spec: &PointSource, state: &mut SourceState, t: f64, material: u32, 
             state.pending = Some([x, d]);
             break;
         }
-        out.push(NewDisk { position: pos, theta: 0.0, velocity: spec.velocity, omega: 0.0, radius: 0.5 * d, fixed: false, material });
+        out.push(NewDisk { position: pos, theta: 0.0, velocity: spec.velocity, omega: 0.0, radius: 0.5 * d, fixed: false, fixed_rotation: false, material });
         state.inserted += 1;
     }
     out

@@ -14,6 +14,7 @@ pub struct SpringDashpot {
     pub k_t: f64,
     pub gamma_t: f64,
     pub mu: f64,
+    pub clamp: bool,
 }
 
 /// Reference overlap, as a fraction of the diameter, at which the stiffness of a
@@ -40,13 +41,13 @@ impl SpringDashpot {
         non_negative("contact.k_t", s.k_t)?;
         non_negative("contact.gamma_t", s.gamma_t)?;
         non_negative("contact.mu", s.mu)?;
-        Ok(Self { k_n: s.k_n, nu: s.nu, psi: s.psi, delta0, gamma_n: s.gamma_n, k_t: s.k_t, gamma_t: s.gamma_t, mu: s.mu })
+        Ok(Self { k_n: s.k_n, nu: s.nu, psi: s.psi, delta0, gamma_n: s.gamma_n, k_t: s.k_t, gamma_t: s.gamma_t, mu: s.mu, clamp: s.clamp })
     }
 
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         let f_el = elastic_force(self.k_n, self.delta0, self.nu, c.delta);
         let f_diss = dissipative_force(self.gamma_n, self.delta0, self.psi, c.delta, c.delta_dot);
-        let f_n = clamp_non_negative(f_el + f_diss);
+        let f_n = if self.clamp { clamp_non_negative(f_el + f_diss) } else { f_el + f_diss };
         let (f_t, xi) = coulomb_spring(c.history, c.v_t, c.dt, self.k_t, self.gamma_t, self.mu, f_n);
         let energy = elastic_energy(self.k_n, self.delta0, self.nu, c.delta) + spring_energy(self.k_t, xi);
         ContactOutput { f_n, f_t, history: xi, energy }
@@ -101,7 +102,7 @@ mod tests {
 
     #[test]
     fn normal_force_never_attracts() {
-        let law = SpringDashpot { k_n: 100.0, nu: 1.0, psi: 0.0, delta0: 1.0, gamma_n: 10.0, k_t: 0.0, gamma_t: 0.0, mu: 0.0 };
+        let law = SpringDashpot { k_n: 100.0, nu: 1.0, psi: 0.0, delta0: 1.0, gamma_n: 10.0, k_t: 0.0, gamma_t: 0.0, mu: 0.0, clamp: true };
         let c = ContactInput { delta: 0.01, delta_dot: -10.0, dt: 1e-3, ..Default::default() };
         assert_eq!(law.evaluate(&c).f_n, 0.0);
         let c = ContactInput { delta: 0.01, delta_dot: 0.0, dt: 1e-3, ..Default::default() };

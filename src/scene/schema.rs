@@ -146,6 +146,11 @@ pub struct SpringDashpotSpec {
     /// Coulomb friction coefficient μ.
     #[serde(default)]
     pub mu: f64,
+    /// Clamp f_n ≥ 0 after damping (SPEC 2). `false` gives the textbook linear
+    /// spring-dashpot whose damping may pull at the end of a contact; it exists to
+    /// compare with the analytic t_c = π/ω and r = exp(−η t_c) (paper 000 sec. 2.1).
+    #[serde(default = "yes")]
+    pub clamp: bool,
 }
 
 /// Continuous r^-(n+1) interaction with tapered friction, paper 001 eq. 3–8.
@@ -342,6 +347,9 @@ pub struct ListedParticle {
     pub omega: f64,
     #[serde(default)]
     pub fixed: bool,
+    /// Never rotates (infinite moment of inertia): a sliding block rather than a roller.
+    #[serde(default)]
+    pub fixed_rotation: bool,
 }
 
 /// What is written and how often (in simulated time; 0 disables).

@@ -1,0 +1,78 @@
+//! Helpers shared by the integration tests: small scenes built in code.
+#![allow(dead_code)]
+
+use serde_json::{Value, json};
+use talus::scene::{self, Scene};
+use talus::sim::Simulation;
+
+/// A scene around `particles` and `contact`, with a large domain, no gravity by default.
+pub fn scene_value(contact: Value, particles: Value) -> Value {
+    json!({
+        "name": "test",
+        "dt": 1e-4,
+        "stop": { "time": 1.0 },
+        "gravity": { "g": [0.0, 0.0] },
+        "domain": { "x": [-100.0, 100.0], "z": [-100.0, 100.0] },
+        "materials": { "m": { "density": 1.2732395447351628 } },
+        "contact": contact,
+        "particles": particles,
+        "output": { "checkpoint_every": 0 }
+    })
+}
+
+pub fn parse(v: &Value) -> Scene {
+    match scene::parse(&v.to_string(), &[]) {
+        Ok(s) => s,
+        Err(e) => panic!("test scene is invalid: {e}"),
+    }
+}
+
+pub fn sim(v: &Value) -> Simulation {
+    Simulation::new(parse(v)).expect("simulation builds")
+}
+
+/// Centre distance of particles a and b.
+pub fn distance(sim: &Simulation, a: usize, b: usize) -> f64 {
+    let (p, q) = (sim.particles.position(a), sim.particles.position(b));
+    ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt()
+}
+
+/// Linear interpolation of the time at which `f` crosses zero between two samples.
+pub fn crossing(t0: f64, f0: f64, t1: f64, f1: f64) -> f64 {
+    t0 + (t1 - t0) * f0 / (f0 - f1)
+}
+
+/// Head-on collision of two equal unit disks (m = 1, radius 0.5) approaching at relative
+/// speed `v0`; returns (contact duration from the overlap δ > 0, restitution).
+pub fn head_on(contact: Value, v0: f64, dt: f64, integrator: &str) -> (f64, f64) {
+    let mut v = scene_value(
+        contact,
+        json!([{ "kind": "list", "material": "m", "particles": [
+            { "position": [-0.6, 0.0], "diameter": 1.0, "velocity": [0.5 * v0, 0.0] },
+            { "position": [0.6, 0.0], "diameter": 1.0, "velocity": [-0.5 * v0, 0.0] }
+        ]}]),
+    );
+    v["dt"] = json!(dt);
+    v["integrator"] = json!(integrator);
+    let mut s = sim(&v);
+    let (mut t_in, mut t_out) = (None, None);
+    let mut prev = (s.time(), 1.0 - distance(&s, 0, 1));
+    for _ in 0..10_000_000 {
+        s.step().expect("no divergence");
+        let now = (s.time(), 1.0 - distance(&s, 0, 1));
+        if t_in.is_none() && prev.1 <= 0.0 && now.1 > 0.0 {
+            t_in = Some(crossing(prev.0, prev.1, now.0, now.1));
+        }
+        if t_in.is_some() && prev.1 > 0.0 && now.1 <= 0.0 {
+            t_out = Some(crossing(prev.0, prev.1, now.0, now.1));
+        }
+        prev = now;
+        // well separated again: measure the outgoing speed in free flight
+        if t_out.is_some() && now.1 < -0.05 {
+            break;
+        }
+    }
+    let vel = |i| s.particles.velocity(i, s.dt())[0];
+    let v_out = vel(1) - vel(0);
+    (t_out.expect("separated") - t_in.expect("collided"), v_out / v0)
+}

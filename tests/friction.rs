@@ -1,0 +1,95 @@
+//! Coulomb friction: stick below tan θ = μ, slide above (SPEC 2.1, paper 000 eq. 5), and
+//! tangential springs that persist through every re-sort of the cell list.
+
+mod common;
+use common::*;
+use serde_json::json;
+
+const MU: f64 = 0.4;
+
+/// A non-rotating disk (a sliding block) on a horizontal wall with gravity tilted by θ,
+/// plus a cloud of free disks falling far away so that the cell list's sorted order
+/// changes every step. Returns (displacement of the block along the wall, final spring
+/// force k_t|ξ| of its wall contact, the block's acceleration along the slope).
+fn block_on_incline(tan_theta: f64) -> (f64, f64, f64) {
+    let theta = tan_theta.atan();
+    let g = 1.0;
+    let mut others: Vec<serde_json::Value> = (0..12)
+        .map(|k| json!({ "position": [-40.0 + 6.0 * k as f64, 60.0 + (k % 3) as f64 * 2.0], "diameter": 1.0 }))
+        .collect();
+    // The block sits in the middle of the id range.
+    others.insert(6, json!({ "position": [0.0, 0.4995], "diameter": 1.0, "fixed_rotation": true }));
+    let mut v = scene_value(
+        json!({ "law": "spring_dashpot", "k_n": 1.0e4, "gamma_n": 20.0, "k_t": 2.0e3, "gamma_t": 10.0, "mu": MU }),
+        json!([{ "kind": "list", "material": "m", "particles": others }]),
+    );
+    v["walls"] = json!([{ "from": [-100.0, 0.0], "to": [100.0, 0.0] }]);
+    v["gravity"] = json!({ "g": [g * theta.sin(), -g * theta.cos()] });
+    v["dt"] = json!(2e-4);
+    let mut s = sim(&v);
+    // settle the normal contact and the spring
+    for _ in 0..20_000 {
+        s.step().unwrap();
+    }
+    let x0 = s.particles.position(6)[0];
+    let v0 = s.particles.velocity(6, s.dt())[0];
+    let t = 2.0;
+    for _ in 0..(t / s.dt()) as usize {
+        s.step().unwrap();
+    }
+    let x1 = s.particles.position(6)[0];
+    let v1 = s.particles.velocity(6, s.dt())[0];
+    let k = s.pairs.iter().position(|p| p.i == 6 && p.is_wall()).expect("block touches the wall");
+    (x1 - x0, s.contacts[k].f_t.abs(), (v1 - v0) / t)
+}
+
+#[test]
+fn block_sticks_below_tan_theta_equals_mu() {
+    let tan_theta = 0.9 * MU;
+    let (dx, f_t, _) = block_on_incline(tan_theta);
+    assert!(dx.abs() < 1e-9, "a sticking block creeps by {dx}");
+    // Static balance along the slope: f_t = m g sin θ with m = 1.
+    let expected = tan_theta.atan().sin();
+    assert!((f_t / expected - 1.0).abs() < 1e-6, "spring force {f_t} vs m g sin θ = {expected}");
+}
+
+#[test]
+fn block_slides_above_tan_theta_equals_mu() {
+    let tan_theta = 1.1 * MU;
+    let theta = tan_theta.atan();
+    let (dx, f_t, a) = block_on_incline(tan_theta);
+    let expected = theta.sin() - MU * theta.cos();
+    assert!(dx > 0.01, "a sliding block moves, dx = {dx}");
+    assert!((a / expected - 1.0).abs() < 1e-3, "acceleration {a} vs g (sin θ − μ cos θ) = {expected}");
+    assert!((f_t / (MU * theta.cos()) - 1.0).abs() < 1e-3, "friction at the Coulomb cap");
+}
+
+/// A free (rolling) disk on the same incline rolls without slipping for μ > tan θ / 3:
+/// its acceleration is (2/3) g sin θ, the friction (1/3) m g sin θ. Checks the rotational
+/// coupling of the tangential force.
+#[test]
+fn disk_rolls_without_slipping() {
+    let tan_theta = 0.5;
+    let theta = f64::atan(tan_theta);
+    let mut v = scene_value(
+        json!({ "law": "spring_dashpot", "k_n": 1.0e4, "gamma_n": 20.0, "k_t": 2.0e3, "gamma_t": 10.0, "mu": MU }),
+        json!([{ "kind": "list", "material": "m", "particles": [{ "position": [0.0, 0.4995], "diameter": 1.0 }] }]),
+    );
+    v["walls"] = json!([{ "from": [-100.0, 0.0], "to": [100.0, 0.0] }]);
+    v["gravity"] = json!({ "g": [theta.sin(), -theta.cos()] });
+    v["dt"] = json!(2e-4);
+    let mut s = sim(&v);
+    for _ in 0..5_000 {
+        s.step().unwrap();
+    }
+    let v0 = s.particles.velocity(0, s.dt());
+    for _ in 0..5_000 {
+        s.step().unwrap();
+    }
+    let v1 = s.particles.velocity(0, s.dt());
+    let a = (v1[0] - v0[0]) / 1.0;
+    let expected = 2.0 / 3.0 * theta.sin();
+    assert!((a / expected - 1.0).abs() < 2e-3, "rolling acceleration {a} vs {expected}");
+    // rolling: v = −ω R
+    assert!((v1[0] + 0.5 * v1[2]).abs() < 1e-3 * v1[0], "no slip: v {} ω {}", v1[0], v1[2]);
+}

@@ -1,0 +1,124 @@
+//! Contact laws against analytic two-particle collisions (paper 000 sec. 2.1, SPEC 2.1).
+
+mod common;
+use common::*;
+use serde_json::json;
+
+/// m1 = m2 = 1 → m12 = 1/2.
+const M12: f64 = 0.5;
+
+/// Paper 000 sec. 2.1: t_c = π/ω, r = exp(−η t_c), ω = sqrt(ω0² − η²), ω0² = k/m12,
+/// η = γ/(2 m12). Valid for the unclamped linear law (the damping may pull at the end).
+#[test]
+fn linear_spring_dashpot_contact_time_and_restitution() {
+    let k = 1.0e4;
+    for eta_over_omega0 in [0.0, 0.05, 0.2, 0.4, 0.6] {
+        let omega0 = (k / M12).sqrt();
+        let eta = eta_over_omega0 * omega0;
+        let gamma = 2.0 * M12 * eta;
+        let omega = (omega0 * omega0 - eta * eta).sqrt();
+        let tc = std::f64::consts::PI / omega;
+        let r = (-eta * tc).exp();
+        let law = json!({ "law": "spring_dashpot", "k_n": k, "gamma_n": gamma, "clamp": false });
+        let (t, e) = head_on(law, 1.0, tc / 400.0, "gear5");
+        assert!((t / tc - 1.0).abs() < 1e-3, "η/ω0 = {eta_over_omega0}: t_c {t} vs {tc}");
+        assert!((e / r - 1.0).abs() < 1e-3, "η/ω0 = {eta_over_omega0}: r {e} vs {r}");
+    }
+}
+
+/// With the SPEC 2 clamp f_n ≥ 0 the force vanishes at the time t* where k δ + γ δ̇ = 0,
+/// tan(ω t*) = −2ηω/(ω0² − 2η²); afterwards the disks fly apart at δ̇(t*). So
+/// r* = e^(−η t*) |cos ω t* − (η/ω) sin ω t*| (from δ = (v0/ω) e^(−ηt) sin ωt).
+#[test]
+fn clamped_spring_dashpot_restitution_matches_its_own_analytic_value() {
+    let k = 1.0e4;
+    let omega0 = (k / M12).sqrt();
+    for eta_over_omega0 in [0.1, 0.3, 0.5] {
+        let eta = eta_over_omega0 * omega0;
+        let omega = (omega0 * omega0 - eta * eta).sqrt();
+        let wt = std::f64::consts::PI - (2.0 * eta * omega / (omega0 * omega0 - 2.0 * eta * eta)).atan();
+        let t_star = wt / omega;
+        let r_star = (-eta * t_star).exp() * (wt.cos() - eta / omega * wt.sin()).abs();
+        let r_unclamped = (-eta * std::f64::consts::PI / omega).exp();
+        let law = json!({ "law": "spring_dashpot", "k_n": k, "gamma_n": 2.0 * M12 * eta });
+        // The force has a kink at t*, which costs Gear its high order there: finer dt.
+        let (_, e) = head_on(law, 1.0, t_star / 4000.0, "gear5");
+        assert!((e / r_star - 1.0).abs() < 1e-3, "η/ω0 = {eta_over_omega0}: r {e} vs {r_star}");
+        assert!(e > r_unclamped, "the clamp removes the attractive pull, so less energy is lost");
+    }
+}
+
+/// Hertz, F = k' δ^(3/2) with k' = k_n δ0^(−1/2) (paper 000 eq. 2 with ν = 3/2), no damping:
+/// δ_max = (5 m12 v0² / (4 k'))^(2/5) and t_c = 2 (δ_max/v0) ∫0^1 (1 − u^(5/2))^(−1/2) du,
+/// the integral being √π Γ(7/5)/Γ(9/10).
+#[test]
+fn hertz_contact_time() {
+    let (k_n, delta0): (f64, f64) = (1.0e4, 0.01);
+    let integral = std::f64::consts::PI.sqrt() * 0.887_263_817_503_075 / 1.068_628_702_119_319;
+    for v0 in [0.5, 1.0, 2.0] {
+        let k = k_n / delta0.sqrt();
+        let delta_max = (5.0 * M12 * v0 * v0 / (4.0 * k)).powf(0.4);
+        let tc = 2.0 * delta_max / v0 * integral;
+        let law = json!({ "law": "spring_dashpot", "k_n": k_n, "nu": 1.5, "delta0": delta0 });
+        let (t, e) = head_on(law, v0, tc / 1000.0, "gear5");
+        assert!((t / tc - 1.0).abs() < 1e-3, "v0 = {v0}: t_c {t} vs {tc}");
+        assert!((e - 1.0).abs() < 1e-3, "elastic collision, r = {e}");
+    }
+}
+
+/// Leapfrog on the same linear collision: second order, so a looser 1e-2 bound.
+#[test]
+fn leapfrog_linear_collision() {
+    let k = 1.0e4;
+    let omega0 = (k / M12).sqrt();
+    let tc = std::f64::consts::PI / omega0;
+    let law = json!({ "law": "spring_dashpot", "k_n": k, "clamp": false });
+    let (t, e) = head_on(law, 1.0, tc / 400.0, "leapfrog");
+    assert!((t / tc - 1.0).abs() < 1e-2, "t_c {t} vs {tc}");
+    assert!((e - 1.0).abs() < 1e-2, "r = {e}");
+}
+
+/// Paper 001: a disk resting on an equal fixed disk under gravity sits at r = σ, where
+/// F_e = m g, for n = 36 and r0 = 1.2σ; both integrators.
+#[test]
+fn continuous_law_rests_at_one_diameter() {
+    for integrator in ["gear5", "leapfrog"] {
+        let mut v = scene_value(
+            json!({ "law": "continuous", "n": 36, "r0": 1.2, "mu": 0.5 }),
+            json!([{ "kind": "list", "material": "m", "particles": [
+                { "position": [0.0, 0.0], "diameter": 1.0, "fixed": true },
+                { "position": [0.0, 1.05], "diameter": 1.0 }
+            ]}]),
+        );
+        v["gravity"] = json!({ "g": [0.0, -1.0] });
+        v["dt"] = json!(1e-3);
+        v["integrator"] = json!(integrator);
+        let mut s = sim(&v);
+        for _ in 0..40_000 {
+            s.step().unwrap();
+        }
+        let r = distance(&s, 0, 1);
+        assert!((r - 1.0).abs() < 1e-6, "{integrator}: rest separation {r}");
+    }
+}
+
+/// Equivalent Hooke law (paper 001 eq. 14): a resting pair compresses to σ − 1/k.
+#[test]
+fn equivalent_hooke_law_rests_at_its_overlap() {
+    let mut v = scene_value(
+        json!({ "law": "hooke_equivalent", "n": 36, "r0": 1.2, "r_i": 0.915 }),
+        json!([{ "kind": "list", "material": "m", "particles": [
+            { "position": [0.0, 0.0], "diameter": 1.0, "fixed": true },
+            { "position": [0.0, 1.0], "diameter": 1.0 }
+        ]}]),
+    );
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["dt"] = json!(1e-3);
+    let mut s = sim(&v);
+    for _ in 0..40_000 {
+        s.step().unwrap();
+    }
+    let k = talus::law::continuous::equivalent_hooke_constant(36.0, 1.2, 0.915);
+    let r = distance(&s, 0, 1);
+    assert!((1.0 - r - 1.0 / k).abs() < 1e-6 / k * 1e3, "overlap {} vs {}", 1.0 - r, 1.0 / k);
+}
