@@ -63,9 +63,40 @@ pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
 
 /// Strict typed parse of a JSON value; errors carry the key path.
 pub fn from_value(value: serde_json::Value) -> Result<Scene, SceneError> {
-    serde_path_to_error::deserialize(value).map_err(|e| {
+    serde_path_to_error::deserialize(value.clone()).map_err(|e| {
         let path = e.path().to_string();
         let path = if path == "." { "scene".to_string() } else { path };
-        SceneError::invalid(path, e.into_inner().to_string())
+        refine_tagged_error(&value, &path).unwrap_or_else(|| SceneError::invalid(path, e.into_inner().to_string()))
     })
+}
+
+/// serde buffers internally tagged enums (`"kind"`, `"law"`), which hides the key inside
+/// them from the path. Re-parse such a block as its variant's struct to find the key.
+fn refine_tagged_error(root: &serde_json::Value, path: &str) -> Option<SceneError> {
+    use serde::de::DeserializeOwned;
+    fn inner<T: DeserializeOwned>(mut block: serde_json::Value, tag: &str, path: &str) -> Option<SceneError> {
+        block.as_object_mut()?.remove(tag);
+        let e = serde_path_to_error::deserialize::<_, T>(block).err()?;
+        let sub = e.path().to_string();
+        let full = if sub == "." { path.to_string() } else { format!("{path}.{sub}") };
+        Some(SceneError::invalid(full, e.into_inner().to_string()))
+    }
+    if path == "contact" {
+        let block = root.get("contact")?.clone();
+        return match block.get("law")?.as_str()? {
+            "spring_dashpot" => inner::<SpringDashpotSpec>(block, "law", path),
+            "continuous" => inner::<ContinuousSpec>(block, "law", path),
+            "hooke_equivalent" => inner::<HookeEquivalentSpec>(block, "law", path),
+            _ => None,
+        };
+    }
+    let k: usize = path.strip_prefix("particles[")?.strip_suffix(']')?.parse().ok()?;
+    let block = root.get("particles")?.get(k)?.clone();
+    match block.get("kind")?.as_str()? {
+        "lattice_pile" => inner::<LatticePile>(block, "kind", path),
+        "row" => inner::<Row>(block, "kind", path),
+        "point_source" => inner::<PointSource>(block, "kind", path),
+        "list" => inner::<ParticleList>(block, "kind", path),
+        _ => None,
+    }
 }

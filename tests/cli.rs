@@ -1,0 +1,123 @@
+//! The `talus` binary: bad scenes give a clear error naming the key, exit code 2 and no
+//! panic; a diverging run stops with the step, the particle ids and the checkpoint.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn talus(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_talus")).args(args).output().expect("binary runs");
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("talus-cli-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The default scene with one edit applied to its JSON text.
+fn scene_file(name: &str, edit: impl Fn(&mut serde_json::Value)) -> PathBuf {
+    let mut v: serde_json::Value = serde_json::from_str(talus::scene::DEFAULT_SCENE).unwrap();
+    edit(&mut v);
+    let p = tmp(name).join("scene.json");
+    std::fs::write(&p, v.to_string()).unwrap();
+    p
+}
+
+fn assert_rejected(args: &[&str], must_mention: &[&str]) {
+    let (code, _, err) = talus(args);
+    assert_eq!(code, 2, "exit code for {args:?}; stderr: {err}");
+    assert!(!err.contains("panicked"), "no panic: {err}");
+    for m in must_mention {
+        assert!(err.contains(m), "error for {args:?} should mention `{m}`: {err}");
+    }
+}
+
+#[test]
+fn unknown_key_is_named() {
+    let p = scene_file("unknown", |v| v["contact"]["k_nn"] = 1.0.into());
+    assert_rejected(&["check", p.to_str().unwrap()], &["contact", "k_nn"]);
+    let p = scene_file("unknown-top", |v| v["gravty"] = 1.0.into());
+    assert_rejected(&["run", p.to_str().unwrap()], &["gravty"]);
+}
+
+#[test]
+fn wrong_type_is_named() {
+    let p = scene_file("type", |v| v["dt"] = "small".into());
+    assert_rejected(&["check", p.to_str().unwrap()], &["dt"]);
+    let p = scene_file("type2", |v| v["particles"][1]["count"] = (-3).into());
+    assert_rejected(&["check", p.to_str().unwrap()], &["particles[1].count"]);
+}
+
+#[test]
+fn negative_radius_is_rejected() {
+    let p = scene_file("radius", |v| v["particles"][0]["diameter"] = (-1.0).into());
+    assert_rejected(&["check", p.to_str().unwrap()], &["particles[0].diameter", "positive"]);
+    assert_rejected(&["check", "--set", "particles[1].diameter={\"uniform\": [-1, 1]}"], &["particles[1].diameter"]);
+}
+
+#[test]
+fn missing_material_is_named() {
+    let p = scene_file("material", |v| v["particles"][1]["material"] = "sand".into());
+    assert_rejected(&["check", p.to_str().unwrap()], &["particles[1].material", "sand", "grain"]);
+}
+
+#[test]
+fn time_step_too_large_for_the_stiffness() {
+    assert_rejected(&["check", "--set", "dt=0.05"], &["dt", "t_c"]);
+    // a stiffer spring makes the default dt too large as well
+    assert_rejected(&["check", "--set", "contact.k_n=1e7"], &["dt", "too large"]);
+    // a mildly large dt only warns
+    let (code, _, err) = talus(&["check", "--set", "dt=0.006"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(err.contains("warning") && err.contains("t_c/10"), "{err}");
+}
+
+#[test]
+fn unreadable_or_malformed_files() {
+    assert_rejected(&["check", "/nonexistent/scene.json"], &["cannot read"]);
+    let p = tmp("syntax").join("s.json");
+    std::fs::write(&p, "{ \"dt\": 0.1, ").unwrap();
+    assert_rejected(&["check", p.to_str().unwrap()], &["not valid JSON"]);
+    assert_rejected(&["check", "--set", "particles[9].rate=1"], &["out of range"]);
+}
+
+#[test]
+fn check_accepts_the_default_scene() {
+    let (code, out, err) = talus(&["check"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("81 particles at start (81 fixed)"), "{out}");
+}
+
+#[test]
+fn diverging_run_stops_with_step_ids_and_checkpoint() {
+    // Two disks thrown at each other far too fast for the spring: the overlap exceeds the
+    // bound on the first contact.
+    let p = tmp("diverge").join("s.json");
+    let scene = serde_json::json!({
+        "name": "diverge", "dt": 1e-3, "stop": { "time": 2.0 },
+        "gravity": { "g": [0.0, 0.0] },
+        "domain": { "x": [-10.0, 10.0], "z": [-10.0, 10.0] },
+        "materials": { "m": { "density": 1.0 } },
+        "contact": { "law": "spring_dashpot", "k_n": 100.0 },
+        "particles": [{ "kind": "list", "material": "m", "particles": [
+            { "position": [-3.0, 0.0], "diameter": 1.0, "velocity": [4.0, 0.0] },
+            { "position": [3.0, 0.0], "diameter": 1.0, "velocity": [-4.0, 0.0] }
+        ]}],
+        "output": { "checkpoint_every": 0.25 }
+    });
+    std::fs::write(&p, scene.to_string()).unwrap();
+    let out = tmp("diverge").join("out");
+    let (code, _, err) = talus(&["run", "-q", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(code, 1, "{err}");
+    assert!(err.contains("diverged at step") && err.contains("particles 0 and 1"), "{err}");
+    assert!(err.contains("last good checkpoint") && err.contains("ckpt_"), "{err}");
+    assert!(!out.join("summary.json").exists(), "no summary for a failed run");
+}
+
+#[test]
+fn gpu_backend_is_reported_as_not_available() {
+    let (code, _, err) = talus(&["run", "--backend", "gpu"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("GPU path is not implemented"), "{err}");
+}
