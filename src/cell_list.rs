@@ -23,8 +23,15 @@ impl Grid {
         let nx = (((x[1] - x[0]) / min_cell).floor() as u32).max(1);
         let nz = (((z[1] - z[0]) / min_cell).floor() as u32).max(1);
         // Stretch the cell so that nx cells fill the width exactly; it stays ≥ min_cell.
-        let cell_size = ((x[1] - x[0]) / nx as f64).max((z[1] - z[0]) / nz as f64).max(min_cell);
-        Self { origin: [x[0], z[0]], cell_size, nx, nz }
+        let cell_size = ((x[1] - x[0]) / nx as f64)
+            .max((z[1] - z[0]) / nz as f64)
+            .max(min_cell);
+        Self {
+            origin: [x[0], z[0]],
+            cell_size,
+            nx,
+            nz,
+        }
     }
 
     pub fn cell_count(&self) -> usize {
@@ -131,7 +138,15 @@ mod tests {
     #[test]
     fn every_active_particle_is_sorted_once_into_its_cell() {
         let grid = Grid::new([0.0, 10.0], [0.0, 5.0], 1.0);
-        let pos: Vec<[f64; 3]> = (0..50).map(|i| [(i * 37 % 100) as f64 / 10.0, (i * 13 % 50) as f64 / 10.0, 0.0]).collect();
+        let pos: Vec<[f64; 3]> = (0..50)
+            .map(|i| {
+                [
+                    (i * 37 % 100) as f64 / 10.0,
+                    (i * 13 % 50) as f64 / 10.0,
+                    0.0,
+                ]
+            })
+            .collect();
         let mut active = vec![true; 50];
         active[7] = false;
         let mut cl = CellList::default();
@@ -145,9 +160,15 @@ mod tests {
         for cz in 0..grid.nz {
             for cx in 0..grid.nx {
                 let ids = cl.cell(&grid, cx, cz);
-                assert!(ids.windows(2).all(|w| w[0] < w[1]), "stable scatter keeps id order");
+                assert!(
+                    ids.windows(2).all(|w| w[0] < w[1]),
+                    "stable scatter keeps id order"
+                );
                 for &i in ids {
-                    assert_eq!(grid.cell_coords([pos[i as usize][0], pos[i as usize][1]]), (cx, cz));
+                    assert_eq!(
+                        grid.cell_coords([pos[i as usize][0], pos[i as usize][1]]),
+                        (cx, cz)
+                    );
                 }
             }
         }

@@ -80,26 +80,40 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
         if !(key.starts_with("stop.") || key.starts_with("output.")) {
             return Err(CheckpointError::Scene(
                 name,
-                crate::scene::SceneError::invalid(key, "only stop.* and output.* can be changed when resuming"),
+                crate::scene::SceneError::invalid(
+                    key,
+                    "only stop.* and output.* can be changed when resuming",
+                ),
             ));
         }
     }
-    let scene = crate::scene::parse(&scene_text, overrides).map_err(|e| CheckpointError::Scene(name.clone(), e))?;
+    let scene = crate::scene::parse(&scene_text, overrides)
+        .map_err(|e| CheckpointError::Scene(name.clone(), e))?;
     let step = d.u64().map_err(corrupt)?;
     let lost = d.u64().map_err(corrupt)?;
-    let rng = Rng { state: d.u64().map_err(corrupt)? };
+    let rng = Rng {
+        state: d.u64().map_err(corrupt)?,
+    };
     let n_sources = d.u64().map_err(corrupt)? as usize;
     let mut sources = Vec::new();
     for _ in 0..n_sources {
         let inserted = d.u32().map_err(corrupt)?;
-        let pending = if d.u8().map_err(corrupt)? == 1 { Some([d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?]) } else { None };
+        let pending = if d.u8().map_err(corrupt)? == 1 {
+            Some([d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?])
+        } else {
+            None
+        };
         sources.push(SourceState { inserted, pending });
     }
     let n = d.u64().map_err(corrupt)? as usize;
     let mut p = Particles::default();
     for k in 0..GEAR_VALUES {
         for _ in 0..n {
-            p.q[k].push([d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?]);
+            p.q[k].push([
+                d.f64().map_err(corrupt)?,
+                d.f64().map_err(corrupt)?,
+                d.f64().map_err(corrupt)?,
+            ]);
         }
     }
     for col in [&mut p.radius, &mut p.mass, &mut p.inertia] {
@@ -117,7 +131,10 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
         p.material.push(d.u32().map_err(corrupt)?);
     }
     let cap = d.u64().map_err(corrupt)? as usize;
-    let mut springs = SpringTable { keys: Vec::with_capacity(cap), values: Vec::with_capacity(cap) };
+    let mut springs = SpringTable {
+        keys: Vec::with_capacity(cap),
+        values: Vec::with_capacity(cap),
+    };
     for _ in 0..cap {
         springs.keys.push(d.u64().map_err(corrupt)?);
     }
@@ -127,5 +144,6 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
     if !d.is_done() || !cap.is_power_of_two() {
         return Err(corrupt(crate::files::DecodeError(bytes.len())));
     }
-    Simulation::from_parts(scene, p, springs, sources, rng, step, lost).map_err(|e| CheckpointError::Scene(name, e))
+    Simulation::from_parts(scene, p, springs, sources, rng, step, lost)
+        .map_err(|e| CheckpointError::Scene(name, e))
 }

@@ -7,7 +7,11 @@ use std::process::ExitCode;
 use talus::{checkpoint, run, scene, sim::Simulation};
 
 #[derive(Parser)]
-#[command(name = "talus", version, about = "2D granular dynamics (DEM) of heaps and packings")]
+#[command(
+    name = "talus",
+    version,
+    about = "2D granular dynamics (DEM) of heaps and packings"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -54,7 +58,14 @@ enum Backend {
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Run { scene, out, overrides, resume, backend, quiet } => cmd_run(scene, out, overrides, resume, backend, quiet),
+        Command::Run {
+            scene,
+            out,
+            overrides,
+            resume,
+            backend,
+            quiet,
+        } => cmd_run(scene, out, overrides, resume, backend, quiet),
         Command::Check { scene, overrides } => cmd_check(scene, overrides),
         Command::DefaultScene => {
             print!("{}", scene::DEFAULT_SCENE);
@@ -68,7 +79,9 @@ fn load_scene(path: &Option<PathBuf>, overrides: &[String]) -> Result<scene::Sce
         Some(p) => scene::load(p, overrides),
         None => scene::parse(scene::DEFAULT_SCENE, overrides),
     };
-    let name = path.as_ref().map_or("default scene".to_string(), |p| p.display().to_string());
+    let name = path
+        .as_ref()
+        .map_or("default scene".to_string(), |p| p.display().to_string());
     loaded.map_err(|e| format!("error in {name}: {e}"))
 }
 
@@ -102,13 +115,22 @@ fn cmd_check(path: Option<PathBuf>, overrides: Vec<String>) -> ExitCode {
     }
 }
 
-fn cmd_run(path: Option<PathBuf>, out: Option<PathBuf>, overrides: Vec<String>, resume: Option<PathBuf>, backend: Backend, quiet: bool) -> ExitCode {
+fn cmd_run(
+    path: Option<PathBuf>,
+    out: Option<PathBuf>,
+    overrides: Vec<String>,
+    resume: Option<PathBuf>,
+    backend: Backend,
+    quiet: bool,
+) -> ExitCode {
     match backend {
         Backend::Gpu => {
             eprintln!("error: the GPU path is not implemented yet; use --backend cpu");
             return ExitCode::from(2);
         }
-        Backend::Auto if !quiet => eprintln!("note: using the CPU reference path (the GPU path is not implemented yet)"),
+        Backend::Auto if !quiet => {
+            eprintln!("note: using the CPU reference path (the GPU path is not implemented yet)")
+        }
         _ => {}
     }
     let mut sim = if let Some(ckpt) = &resume {
@@ -149,7 +171,13 @@ fn cmd_run(path: Option<PathBuf>, out: Option<PathBuf>, overrides: Vec<String>, 
             out.display()
         );
     }
-    match run::run(&mut sim, &run::RunOptions { out: out.clone(), quiet }) {
+    match run::run(
+        &mut sim,
+        &run::RunOptions {
+            out: out.clone(),
+            quiet,
+        },
+    ) {
         Ok(s) => {
             if !quiet {
                 eprintln!(

@@ -51,7 +51,12 @@ pub fn find_contacts(
                     if ju <= i || (particles.fixed[i] && particles.fixed[ju]) {
                         continue;
                     }
-                    let g = disk_disk(pi, particles.radius[i], [pos[ju][0], pos[ju][1]], particles.radius[ju]);
+                    let g = disk_disk(
+                        pi,
+                        particles.radius[i],
+                        [pos[ju][0], pos[ju][1]],
+                        particles.radius[ju],
+                    );
                     if g.r < range_factor * g.sigma {
                         out.push(Pair { i: i as u32, j });
                     }
@@ -67,14 +72,21 @@ pub fn find_contacts(
         for (w, wall) in walls.iter().enumerate() {
             let g = disk_wall(pi, particles.radius[i], wall);
             if g.r < range_factor * g.sigma {
-                out.push(Pair { i: i as u32, j: WALL_BASE + w as u32 });
+                out.push(Pair {
+                    i: i as u32,
+                    j: WALL_BASE + w as u32,
+                });
             }
         }
     }
 }
 
 /// Reference O(N²) search used by tests to check `find_contacts`.
-pub fn brute_force_contacts(particles: &Particles, walls: &[WallSegment], range_factor: f64) -> Vec<Pair> {
+pub fn brute_force_contacts(
+    particles: &Particles,
+    walls: &[WallSegment],
+    range_factor: f64,
+) -> Vec<Pair> {
     let mut out = Vec::new();
     let pos = &particles.q[0];
     for i in 0..particles.len() {
@@ -85,9 +97,17 @@ pub fn brute_force_contacts(particles: &Particles, walls: &[WallSegment], range_
             if !particles.active[j] || (particles.fixed[i] && particles.fixed[j]) {
                 continue;
             }
-            let g = disk_disk([pos[i][0], pos[i][1]], particles.radius[i], [pos[j][0], pos[j][1]], particles.radius[j]);
+            let g = disk_disk(
+                [pos[i][0], pos[i][1]],
+                particles.radius[i],
+                [pos[j][0], pos[j][1]],
+                particles.radius[j],
+            );
             if g.r < range_factor * g.sigma {
-                out.push(Pair { i: i as u32, j: j as u32 });
+                out.push(Pair {
+                    i: i as u32,
+                    j: j as u32,
+                });
             }
         }
         if particles.fixed[i] {
@@ -96,7 +116,10 @@ pub fn brute_force_contacts(particles: &Particles, walls: &[WallSegment], range_
         for (w, wall) in walls.iter().enumerate() {
             let g = disk_wall([pos[i][0], pos[i][1]], particles.radius[i], wall);
             if g.r < range_factor * g.sigma {
-                out.push(Pair { i: i as u32, j: WALL_BASE + w as u32 });
+                out.push(Pair {
+                    i: i as u32,
+                    j: WALL_BASE + w as u32,
+                });
             }
         }
     }

@@ -46,24 +46,56 @@ pub fn contact_forces(
         let (g, input) = contact_input(particles, walls, dt, pair, history);
         let res = law.evaluate(&input);
         let t = tangent(g.n);
-        let force = [res.f_n * g.n[0] + res.f_t * t[0], res.f_n * g.n[1] + res.f_t * t[1]];
-        out.push(ContactForce { force, point: g.point, n: g.n, f_n: res.f_n, f_t: res.f_t, overlap: g.delta, energy: res.energy });
+        let force = [
+            res.f_n * g.n[0] + res.f_t * t[0],
+            res.f_n * g.n[1] + res.f_t * t[1],
+        ];
+        out.push(ContactForce {
+            force,
+            point: g.point,
+            n: g.n,
+            f_n: res.f_n,
+            f_t: res.f_t,
+            overlap: g.delta,
+            energy: res.energy,
+        });
         history_out.push(res.history);
     }
 }
 
 /// Geometry and kinematics of one contact: what the law needs.
-pub fn contact_input(particles: &Particles, walls: &[WallSegment], dt: f64, pair: Pair, history: f64) -> (Geometry, ContactInput) {
+pub fn contact_input(
+    particles: &Particles,
+    walls: &[WallSegment],
+    dt: f64,
+    pair: Pair,
+    history: f64,
+) -> (Geometry, ContactInput) {
     let i = pair.i as usize;
     let p1 = particles.position(i);
     let v1 = particles.velocity(i, dt);
     let (g, v2, w2, m2) = if pair.is_wall() {
         let wall = &walls[(pair.j - WALL_BASE) as usize];
-        (disk_wall(p1, particles.radius[i], wall), [0.0, 0.0], 0.0, f64::INFINITY)
+        (
+            disk_wall(p1, particles.radius[i], wall),
+            [0.0, 0.0],
+            0.0,
+            f64::INFINITY,
+        )
     } else {
         let j = pair.j as usize;
         let v = particles.velocity(j, dt);
-        (disk_disk(p1, particles.radius[i], particles.position(j), particles.radius[j]), [v[0], v[1]], v[2], particles.mass[j])
+        (
+            disk_disk(
+                p1,
+                particles.radius[i],
+                particles.position(j),
+                particles.radius[j],
+            ),
+            [v[0], v[1]],
+            v[2],
+            particles.mass[j],
+        )
     };
     let l1 = [g.point[0] - p1[0], g.point[1] - p1[1]];
     let s1 = spin_velocity(v1[2], l1);
@@ -77,7 +109,12 @@ pub fn contact_input(particles: &Particles, walls: &[WallSegment], dt: f64, pair
     let v12 = [v1[0] + s1[0] - v2[0] - s2[0], v1[1] + s1[1] - v2[1] - s2[1]];
     let t = tangent(g.n);
     let m1 = particles.mass[i];
-    let (m12, mass) = if m2.is_infinite() { (m1, m1) } else { let m12 = m1 * m2 / (m1 + m2); (m12, 2.0 * m12) };
+    let (m12, mass) = if m2.is_infinite() {
+        (m1, m1)
+    } else {
+        let m12 = m1 * m2 / (m1 + m2);
+        (m12, 2.0 * m12)
+    };
     let input = ContactInput {
         delta: g.delta,
         r: g.r,
@@ -93,7 +130,12 @@ pub fn contact_input(particles: &Particles, walls: &[WallSegment], dt: f64, pair
 }
 
 /// Stage: total contact force and torque (fx, fz, τ) on every particle.
-pub fn reduce_forces(particles: &Particles, pairs: &[Pair], contacts: &[ContactForce], out: &mut Vec<Dof>) {
+pub fn reduce_forces(
+    particles: &Particles,
+    pairs: &[Pair],
+    contacts: &[ContactForce],
+    out: &mut Vec<Dof>,
+) {
     out.clear();
     out.resize(particles.len(), [0.0; 3]);
     for (pair, c) in pairs.iter().zip(contacts) {

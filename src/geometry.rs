@@ -43,11 +43,21 @@ pub fn disk_disk(p1: [f64; 2], r1: f64, p2: [f64; 2], r2: f64) -> Geometry {
     let d = [p1[0] - p2[0], p1[1] - p2[1]];
     let r = (d[0] * d[0] + d[1] * d[1]).sqrt();
     // Coincident centres: any direction is as good; pick +z so the force stays finite.
-    let n = if r > 0.0 { [d[0] / r, d[1] / r] } else { [0.0, 1.0] };
+    let n = if r > 0.0 {
+        [d[0] / r, d[1] / r]
+    } else {
+        [0.0, 1.0]
+    };
     let sigma = r1 + r2;
     let delta = sigma - r;
     let arm = r1 - 0.5 * delta;
-    Geometry { n, delta, r, sigma, point: [p1[0] - n[0] * arm, p1[1] - n[1] * arm] }
+    Geometry {
+        n,
+        delta,
+        r,
+        sigma,
+        point: [p1[0] - n[0] * arm, p1[1] - n[1] * arm],
+    }
 }
 
 /// A disk and a wall segment: δ = R − distance to the closest point of the segment. The
@@ -55,15 +65,34 @@ pub fn disk_disk(p1: [f64; 2], r1: f64, p2: [f64; 2], r2: f64) -> Geometry {
 pub fn disk_wall(p: [f64; 2], radius: f64, w: &WallSegment) -> Geometry {
     let ab = [w.b[0] - w.a[0], w.b[1] - w.a[1]];
     let len2 = ab[0] * ab[0] + ab[1] * ab[1];
-    let s = if len2 > 0.0 { (((p[0] - w.a[0]) * ab[0] + (p[1] - w.a[1]) * ab[1]) / len2).clamp(0.0, 1.0) } else { 0.0 };
+    let s = if len2 > 0.0 {
+        (((p[0] - w.a[0]) * ab[0] + (p[1] - w.a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let c = [w.a[0] + s * ab[0], w.a[1] + s * ab[1]];
     let d = [p[0] - c[0], p[1] - c[1]];
     let dist = (d[0] * d[0] + d[1] * d[1]).sqrt();
-    let n = if dist > 0.0 { [d[0] / dist, d[1] / dist] } else { [-ab[1], ab[0]] };
-    let n = if dist > 0.0 { n } else { let l = len2.sqrt().max(f64::MIN_POSITIVE); [n[0] / l, n[1] / l] };
+    let n = if dist > 0.0 {
+        [d[0] / dist, d[1] / dist]
+    } else {
+        [-ab[1], ab[0]]
+    };
+    let n = if dist > 0.0 {
+        n
+    } else {
+        let l = len2.sqrt().max(f64::MIN_POSITIVE);
+        [n[0] / l, n[1] / l]
+    };
     let delta = radius - dist;
     let arm = radius - 0.5 * delta;
-    Geometry { n, delta, r: 2.0 * dist, sigma: 2.0 * radius, point: [p[0] - n[0] * arm, p[1] - n[1] * arm] }
+    Geometry {
+        n,
+        delta,
+        r: 2.0 * dist,
+        sigma: 2.0 * radius,
+        point: [p[0] - n[0] * arm, p[1] - n[1] * arm],
+    }
 }
 
 #[cfg(test)]
@@ -80,7 +109,10 @@ mod tests {
 
     #[test]
     fn disk_wall_uses_closest_point_and_ends() {
-        let w = WallSegment { a: [0.0, 0.0], b: [10.0, 0.0] };
+        let w = WallSegment {
+            a: [0.0, 0.0],
+            b: [10.0, 0.0],
+        };
         let g = disk_wall([3.0, 0.4], 0.5, &w);
         assert!((g.delta - 0.1).abs() < 1e-15);
         assert_eq!(g.n, [0.0, 1.0]);

@@ -7,18 +7,18 @@
 
 pub mod cell_list;
 pub mod checkpoint;
-pub mod files;
 pub mod contacts;
 pub mod create;
+pub mod files;
 pub mod forces;
 pub mod geometry;
 pub mod integrate;
 pub mod law;
-pub mod snapshot;
 pub mod progress;
 pub mod rng;
 pub mod run;
 pub mod scene;
 pub mod sim;
+pub mod snapshot;
 pub mod springs;
 pub mod state;

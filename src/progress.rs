@@ -20,7 +20,8 @@ impl Progress {
     /// `start_step..total` is the range of steps this run will take.
     pub fn new(start_step: u64, total: u64, quiet: bool) -> Self {
         let bar = if !quiet && std::io::stderr().is_terminal() {
-            let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr_with_hz(4));
+            let b =
+                ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr_with_hz(4));
             b.set_style(
                 ProgressStyle::with_template("{bar:30.cyan/blue} {percent:>3}% {msg} ETA {eta}")
                     .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -30,7 +31,14 @@ impl Progress {
         } else {
             None
         };
-        Self { bar, quiet, start: Instant::now(), start_step, total, next_line: start_step }
+        Self {
+            bar,
+            quiet,
+            start: Instant::now(),
+            start_step,
+            total,
+            next_line: start_step,
+        }
     }
 
     /// Steps per second of wall time since this run started.
@@ -49,7 +57,10 @@ impl Progress {
             b.set_message(msg);
         } else if step >= self.next_line {
             let eta = (self.total - step) as f64 / rate.max(1e-9);
-            eprintln!("  {:>3.0}% {msg} ETA {eta:.0}s", 100.0 * step as f64 / self.total as f64);
+            eprintln!(
+                "  {:>3.0}% {msg} ETA {eta:.0}s",
+                100.0 * step as f64 / self.total as f64
+            );
             self.next_line = step + (self.total / 10).max(1);
         }
     }

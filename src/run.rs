@@ -41,13 +41,24 @@ pub struct RunSummary {
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
     #[error("cannot write {path}: {source}")]
-    Io { path: String, source: std::io::Error },
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
     #[error("run diverged at step {step} (t = {time:.6e}): {cause}; {checkpoint}")]
-    Diverged { step: u64, time: f64, cause: Divergence, checkpoint: String },
+    Diverged {
+        step: u64,
+        time: f64,
+        cause: Divergence,
+        checkpoint: String,
+    },
 }
 
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
-    move |source| RunError::Io { path: path.display().to_string(), source }
+    move |source| RunError::Io {
+        path: path.display().to_string(),
+        source,
+    }
 }
 
 /// Steps between events that happen every `interval` of simulated time (0 = never).
@@ -71,7 +82,14 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
     let o = sim.scene.output.clone();
     let snap_every = every(o.snapshot_every, dt);
     let ckpt_every = every(o.checkpoint_every.unwrap_or(0.1 * sim.scene.stop.time), dt);
-    let log_every = every(if o.log_every > 0.0 { o.log_every } else { sim.scene.stop.time / 200.0 }, dt);
+    let log_every = every(
+        if o.log_every > 0.0 {
+            o.log_every
+        } else {
+            sim.scene.stop.time / 200.0
+        },
+        dt,
+    );
     let check_every = every(sim.scene.stop.check_every, dt).unwrap_or(1);
     let total = total_steps(sim);
     let snap_dir = out.join("snapshots");
@@ -81,11 +99,14 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
     let start = Instant::now();
     let start_step = sim.step;
     let mut particle_steps = 0u64;
-    let mut log = String::from("step,time,particles,contacts,kinetic_translational,kinetic_rotational,elastic,potential\n");
+    let mut log = String::from(
+        "step,time,particles,contacts,kinetic_translational,kinetic_rotational,elastic,potential\n",
+    );
     let mut checkpoints: Vec<PathBuf> = Vec::new();
     let mut settled = false;
     if sim.step == 0 && snap_every.is_some() {
-        let p = snapshot::write(sim, &snap_dir, &format!("snap_{:010}", 0)).map_err(io(&snap_dir))?;
+        let p =
+            snapshot::write(sim, &snap_dir, &format!("snap_{:010}", 0)).map_err(io(&snap_dir))?;
         let _ = p;
     }
 
@@ -94,10 +115,22 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
         if let Err(cause) = sim.step() {
             progress.finish();
             let checkpoint = match checkpoints.last() {
-                Some(p) => format!("last good checkpoint: {} (continue with `talus run --resume {}`)", p.display(), p.display()),
-                None => "no checkpoint was written before the divergence (see output.checkpoint_every)".into(),
+                Some(p) => format!(
+                    "last good checkpoint: {} (continue with `talus run --resume {}`)",
+                    p.display(),
+                    p.display()
+                ),
+                None => {
+                    "no checkpoint was written before the divergence (see output.checkpoint_every)"
+                        .into()
+                }
             };
-            return Err(RunError::Diverged { step: sim.step, time: sim.time(), cause, checkpoint });
+            return Err(RunError::Diverged {
+                step: sim.step,
+                time: sim.time(),
+                cause,
+                checkpoint,
+            });
         }
         particle_steps += active;
         let step = sim.step;
@@ -128,7 +161,11 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
                 if sim.time() >= sim.scene.stop.not_before && sim.feeding_done() {
                     let e = sim.energies();
                     if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
-                        progress.note(&format!("settled at t = {:.4}: kinetic/elastic = {:.3e}", sim.time(), e.kinetic() / e.elastic));
+                        progress.note(&format!(
+                            "settled at t = {:.4}: kinetic/elastic = {:.3e}",
+                            sim.time(),
+                            e.kinetic() / e.elastic
+                        ));
                         settled = true;
                         break;
                     }
@@ -140,7 +177,11 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
     }
     progress.finish();
 
-    if checkpoints.last().is_none_or(|p| !p.ends_with(format!("ckpt_{:010}.bin", sim.step))) && ckpt_every.is_some() {
+    if checkpoints
+        .last()
+        .is_none_or(|p| !p.ends_with(format!("ckpt_{:010}.bin", sim.step)))
+        && ckpt_every.is_some()
+    {
         write_checkpoint(sim, &ckpt_dir, &mut checkpoints)?;
     }
     let log_path = out.join("log.csv");
@@ -170,7 +211,11 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
     Ok(summary)
 }
 
-fn write_checkpoint(sim: &Simulation, dir: &Path, written: &mut Vec<PathBuf>) -> Result<(), RunError> {
+fn write_checkpoint(
+    sim: &Simulation,
+    dir: &Path,
+    written: &mut Vec<PathBuf>,
+) -> Result<(), RunError> {
     let path = dir.join(format!("ckpt_{:010}.bin", sim.step));
     checkpoint::write(sim, &path).map_err(io(&path))?;
     written.push(path);

@@ -19,8 +19,15 @@ use crate::state::{Dof, Particles};
 pub enum Divergence {
     #[error("particle {id} has a non-finite {what}")]
     NotFinite { id: u32, what: &'static str },
-    #[error("particles {i} and {j} overlap by {ratio:.3} of the smaller radius (limits.max_overlap = {limit})")]
-    Overlap { i: u32, j: String, ratio: f64, limit: f64 },
+    #[error(
+        "particles {i} and {j} overlap by {ratio:.3} of the smaller radius (limits.max_overlap = {limit})"
+    )]
+    Overlap {
+        i: u32,
+        j: String,
+        ratio: f64,
+        limit: f64,
+    },
 }
 
 /// Energies at the end of a step.
@@ -66,8 +73,14 @@ impl Simulation {
     pub fn new(scene: Scene) -> Result<Self, SceneError> {
         let mut rng = Rng::new(scene.seed);
         let particles = create::initial_particles(&scene, &mut rng);
-        let sources = scene.particles.iter().filter(|c| matches!(c, Creation::PointSource(_))).map(|_| SourceState::default()).collect();
-        let mut sim = Self::from_parts(scene, particles, SpringTable::default(), sources, rng, 0, 0)?;
+        let sources = scene
+            .particles
+            .iter()
+            .filter(|c| matches!(c, Creation::PointSource(_)))
+            .map(|_| SourceState::default())
+            .collect();
+        let mut sim =
+            Self::from_parts(scene, particles, SpringTable::default(), sources, rng, 0, 0)?;
         // Start Gear with the gravitational acceleration in q2 so free flight is exact
         // from the first step.
         let g = sim.gravity(0.0);
@@ -89,7 +102,11 @@ impl Simulation {
     ) -> Result<Self, SceneError> {
         let g = scene.gravity.g;
         let law = ContactLaw::from_spec(&scene.contact, (g[0] * g[0] + g[1] * g[1]).sqrt())?;
-        let walls = scene.walls.iter().map(|w| WallSegment { a: w.from, b: w.to }).collect();
+        let walls = scene
+            .walls
+            .iter()
+            .map(|w| WallSegment { a: w.from, b: w.to })
+            .collect();
         let max_d = crate::scene::max_diameter(&scene).max(2.0 * particles.max_radius());
         let grid = Grid::new(scene.domain.x, scene.domain.z, law.range_factor() * max_d);
         Ok(Self {
@@ -135,7 +152,8 @@ impl Simulation {
             Creation::PointSource(s) => Some(s),
             _ => None,
         });
-        specs.zip(&self.sources).all(|(spec, st)| st.done(spec)) && self.time() >= self.scene.gravity.ramp_time
+        specs.zip(&self.sources).all(|(spec, st)| st.done(spec))
+            && self.time() >= self.scene.gravity.ramp_time
     }
 
     fn seed_acceleration(&mut self, i: usize, g: [f64; 2]) {
@@ -155,13 +173,35 @@ impl Simulation {
         if gear {
             gear::predict(&mut self.particles);
         }
-        self.cells.build(&self.grid, &self.particles.q[0], &self.particles.active);
-        find_contacts(&self.grid, &self.cells, &self.particles, &self.walls, self.law.range_factor(), &mut self.pairs);
+        self.cells
+            .build(&self.grid, &self.particles.q[0], &self.particles.active);
+        find_contacts(
+            &self.grid,
+            &self.cells,
+            &self.particles,
+            &self.walls,
+            self.law.range_factor(),
+            &mut self.pairs,
+        );
         gather_history(&self.springs, &self.pairs, &mut self.history_in);
-        contact_forces(&self.particles, &self.walls, &self.law, dt, &self.pairs, &self.history_in, &mut self.contacts, &mut self.history_out);
+        contact_forces(
+            &self.particles,
+            &self.walls,
+            &self.law,
+            dt,
+            &self.pairs,
+            &self.history_in,
+            &mut self.contacts,
+            &mut self.history_out,
+        );
         self.check_divergence()?;
         store_history(&self.pairs, &self.history_out, &mut self.springs);
-        reduce_forces(&self.particles, &self.pairs, &self.contacts, &mut self.forces);
+        reduce_forces(
+            &self.particles,
+            &self.pairs,
+            &self.contacts,
+            &mut self.forces,
+        );
         if gear {
             // Forces were evaluated at the predicted state, i.e. at time t + dt.
             let g = self.gravity(t + dt);
@@ -178,9 +218,18 @@ impl Simulation {
     fn insert_from_sources(&mut self, t: f64) {
         let mut k = 0;
         for block in &self.scene.particles {
-            let Creation::PointSource(spec) = block else { continue };
+            let Creation::PointSource(spec) = block else {
+                continue;
+            };
             let material = create::material_index(&self.scene, &spec.material);
-            let disks = create::source::emit(spec, &mut self.sources[k], t, material, &self.particles, &mut self.rng);
+            let disks = create::source::emit(
+                spec,
+                &mut self.sources[k],
+                t,
+                material,
+                &self.particles,
+                &mut self.rng,
+            );
             for d in disks {
                 let id = create::push(&self.scene, &mut self.particles, &d) as usize;
                 let h = 0.5 * self.scene.dt * self.scene.dt;
@@ -197,19 +246,38 @@ impl Simulation {
         let limit = self.scene.limits.max_overlap;
         for (pair, c) in self.pairs.iter().zip(&self.contacts) {
             let ri = self.particles.radius[pair.i as usize];
-            let rmin = if pair.is_wall() { ri } else { ri.min(self.particles.radius[pair.j as usize]) };
+            let rmin = if pair.is_wall() {
+                ri
+            } else {
+                ri.min(self.particles.radius[pair.j as usize])
+            };
             if !(c.force[0].is_finite() && c.force[1].is_finite()) {
-                return Err(Divergence::NotFinite { id: pair.i, what: "contact force" });
+                return Err(Divergence::NotFinite {
+                    id: pair.i,
+                    what: "contact force",
+                });
             }
             let ratio = c.overlap / rmin;
             if ratio > limit {
-                let j = if pair.is_wall() { format!("wall {}", pair.j - crate::contacts::WALL_BASE) } else { pair.j.to_string() };
-                return Err(Divergence::Overlap { i: pair.i, j, ratio, limit });
+                let j = if pair.is_wall() {
+                    format!("wall {}", pair.j - crate::contacts::WALL_BASE)
+                } else {
+                    pair.j.to_string()
+                };
+                return Err(Divergence::Overlap {
+                    i: pair.i,
+                    j,
+                    ratio,
+                    limit,
+                });
             }
         }
         for i in 0..self.particles.len() {
             if self.particles.active[i] && !self.particles.q[0][i].iter().all(|v| v.is_finite()) {
-                return Err(Divergence::NotFinite { id: i as u32, what: "position" });
+                return Err(Divergence::NotFinite {
+                    id: i as u32,
+                    what: "position",
+                });
             }
         }
         Ok(())

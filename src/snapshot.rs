@@ -81,11 +81,13 @@ impl Builder {
         let offset = self.bytes.len() as u64;
         let (dtype, count) = match &col {
             Column::F64(v) => {
-                v.iter().for_each(|x| self.bytes.extend_from_slice(&x.to_le_bytes()));
+                v.iter()
+                    .for_each(|x| self.bytes.extend_from_slice(&x.to_le_bytes()));
                 ("f64", v.len())
             }
             Column::U32(v) => {
-                v.iter().for_each(|x| self.bytes.extend_from_slice(&x.to_le_bytes()));
+                v.iter()
+                    .for_each(|x| self.bytes.extend_from_slice(&x.to_le_bytes()));
                 ("u32", v.len())
             }
             Column::U8(v) => {
@@ -93,7 +95,14 @@ impl Builder {
                 ("u8", v.len())
             }
         };
-        self.columns.push(ColumnMeta { table: table.into(), name: name.into(), dtype: dtype.into(), unit: unit.into(), offset, count: count as u64 });
+        self.columns.push(ColumnMeta {
+            table: table.into(),
+            name: name.into(),
+            dtype: dtype.into(),
+            unit: unit.into(),
+            offset,
+            count: count as u64,
+        });
     }
 }
 
@@ -108,24 +117,61 @@ pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBu
         crate::scene::Units::Reduced => ("sigma", "sqrt(sigma/g)", "m"),
     };
     let vel = format!("{len}/{time}");
-    let force = if sim.scene.units == crate::scene::Units::Si { "N".to_string() } else { "m g".to_string() };
-    let mut b = Builder { bytes: Vec::new(), columns: Vec::new() };
-    b.push("particles", "id", "", Column::U32(ids.iter().map(|&i| i as u32).collect()));
+    let force = if sim.scene.units == crate::scene::Units::Si {
+        "N".to_string()
+    } else {
+        "m g".to_string()
+    };
+    let mut b = Builder {
+        bytes: Vec::new(),
+        columns: Vec::new(),
+    };
+    b.push(
+        "particles",
+        "id",
+        "",
+        Column::U32(ids.iter().map(|&i| i as u32).collect()),
+    );
     b.push("particles", "x", len, f(&|i| p.q[0][i][0]));
     b.push("particles", "z", len, f(&|i| p.q[0][i][1]));
     b.push("particles", "theta", "rad", f(&|i| p.q[0][i][2]));
     b.push("particles", "vx", &vel, f(&|i| p.q[1][i][0] / dt));
     b.push("particles", "vz", &vel, f(&|i| p.q[1][i][1] / dt));
-    b.push("particles", "omega", &format!("rad/{time}"), f(&|i| p.q[1][i][2] / dt));
+    b.push(
+        "particles",
+        "omega",
+        &format!("rad/{time}"),
+        f(&|i| p.q[1][i][2] / dt),
+    );
     b.push("particles", "radius", len, f(&|i| p.radius[i]));
     b.push("particles", "mass", mass, f(&|i| p.mass[i]));
-    b.push("particles", "fixed", "", Column::U8(ids.iter().map(|&i| p.fixed[i] as u8).collect()));
-    b.push("particles", "material", "", Column::U32(ids.iter().map(|&i| p.material[i]).collect()));
+    b.push(
+        "particles",
+        "fixed",
+        "",
+        Column::U8(ids.iter().map(|&i| p.fixed[i] as u8).collect()),
+    );
+    b.push(
+        "particles",
+        "material",
+        "",
+        Column::U32(ids.iter().map(|&i| p.material[i]).collect()),
+    );
     let c = &sim.contacts;
     let pairs = &sim.pairs;
     let cf = |g: &dyn Fn(usize) -> f64| Column::F64((0..c.len()).map(g).collect());
-    b.push("contacts", "i", "", Column::U32(pairs.iter().map(|q| q.i).collect()));
-    b.push("contacts", "j", "", Column::U32(pairs.iter().map(|q| q.j).collect()));
+    b.push(
+        "contacts",
+        "i",
+        "",
+        Column::U32(pairs.iter().map(|q| q.i).collect()),
+    );
+    b.push(
+        "contacts",
+        "j",
+        "",
+        Column::U32(pairs.iter().map(|q| q.j).collect()),
+    );
     b.push("contacts", "nx", "", cf(&|k| c[k].n[0]));
     b.push("contacts", "nz", "", cf(&|k| c[k].n[1]));
     b.push("contacts", "fn", &force, cf(&|k| c[k].f_n));
@@ -155,8 +201,10 @@ pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBu
 
 /// Reads a snapshot from its `.json` path.
 pub fn read(json_path: &Path) -> Result<Snapshot, String> {
-    let text = std::fs::read_to_string(json_path).map_err(|e| format!("{}: {e}", json_path.display()))?;
-    let meta: Meta = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    let text =
+        std::fs::read_to_string(json_path).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    let meta: Meta =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", json_path.display()))?;
     if meta.format != FORMAT {
         return Err(format!("{}: not a talus snapshot", json_path.display()));
     }
@@ -172,10 +220,25 @@ pub fn read(json_path: &Path) -> Result<Snapshot, String> {
         };
         let start = c.offset as usize;
         let end = start + size * c.count as usize;
-        let raw = bytes.get(start..end).ok_or_else(|| format!("column {}.{} runs past the end of {}", c.table, c.name, bin.display()))?;
+        let raw = bytes.get(start..end).ok_or_else(|| {
+            format!(
+                "column {}.{} runs past the end of {}",
+                c.table,
+                c.name,
+                bin.display()
+            )
+        })?;
         let col = match size {
-            8 => Column::F64(raw.chunks_exact(8).map(|b| f64::from_le_bytes(b.try_into().unwrap())).collect()),
-            4 => Column::U32(raw.chunks_exact(4).map(|b| u32::from_le_bytes(b.try_into().unwrap())).collect()),
+            8 => Column::F64(
+                raw.chunks_exact(8)
+                    .map(|b| f64::from_le_bytes(b.try_into().unwrap()))
+                    .collect(),
+            ),
+            4 => Column::U32(
+                raw.chunks_exact(4)
+                    .map(|b| u32::from_le_bytes(b.try_into().unwrap()))
+                    .collect(),
+            ),
             _ => Column::U8(raw.to_vec()),
         };
         columns.insert(format!("{}.{}", c.table, c.name), col);

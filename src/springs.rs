@@ -44,7 +44,10 @@ impl SpringTable {
     /// An empty table able to hold `n` entries at load ≤ 1/2.
     pub fn with_capacity_for(n: usize) -> Self {
         let cap = (2 * n).next_power_of_two().max(MIN_CAPACITY);
-        Self { keys: vec![EMPTY; cap], values: vec![0.0; cap] }
+        Self {
+            keys: vec![EMPTY; cap],
+            values: vec![0.0; cap],
+        }
     }
 
     pub fn capacity(&self) -> usize {
@@ -84,14 +87,22 @@ impl SpringTable {
 
     /// All (key, value) entries in slot order.
     pub fn entries(&self) -> impl Iterator<Item = (u64, f64)> + '_ {
-        self.keys.iter().zip(&self.values).filter(|(k, _)| **k != EMPTY).map(|(k, v)| (*k, *v))
+        self.keys
+            .iter()
+            .zip(&self.values)
+            .filter(|(k, _)| **k != EMPTY)
+            .map(|(k, v)| (*k, *v))
     }
 }
 
 /// Stage: the previous history of each current contact (0 for a new contact).
 pub fn gather_history(table: &SpringTable, pairs: &[Pair], out: &mut Vec<f64>) {
     out.clear();
-    out.extend(pairs.iter().map(|&p| table.lookup(pair_key(p)).unwrap_or(0.0)));
+    out.extend(
+        pairs
+            .iter()
+            .map(|&p| table.lookup(pair_key(p)).unwrap_or(0.0)),
+    );
 }
 
 /// Stage: a fresh table holding the updated history of the current contacts.
@@ -119,23 +130,41 @@ mod tests {
             let mut pairs: Vec<Pair> = reference
                 .keys()
                 .filter(|_| rng.uniform() < 0.8)
-                .map(|&k| Pair { i: (k >> 32) as u32, j: k as u32 })
+                .map(|&k| Pair {
+                    i: (k >> 32) as u32,
+                    j: k as u32,
+                })
                 .collect();
             for _ in 0..(rng.uniform() * 40.0) as usize {
                 let i = (rng.uniform() * 500.0) as u32;
-                pairs.push(Pair { i, j: i + 1 + (rng.uniform() * 20.0) as u32 });
+                pairs.push(Pair {
+                    i,
+                    j: i + 1 + (rng.uniform() * 20.0) as u32,
+                });
             }
             pairs.sort();
             pairs.dedup();
             let mut hist = Vec::new();
             gather_history(&table, &pairs, &mut hist);
             for (p, h) in pairs.iter().zip(&hist) {
-                assert_eq!(*h, reference.get(&pair_key(*p)).copied().unwrap_or(0.0), "step {step}");
+                assert_eq!(
+                    *h,
+                    reference.get(&pair_key(*p)).copied().unwrap_or(0.0),
+                    "step {step}"
+                );
             }
             let updated: Vec<f64> = hist.iter().map(|h| h + 1.0 + step as f64).collect();
             store_history(&pairs, &updated, &mut table);
-            reference = pairs.iter().zip(&updated).map(|(p, v)| (pair_key(*p), *v)).collect();
-            assert_eq!(table.len(), reference.len(), "no lost or duplicated springs");
+            reference = pairs
+                .iter()
+                .zip(&updated)
+                .map(|(p, v)| (pair_key(*p), *v))
+                .collect();
+            assert_eq!(
+                table.len(),
+                reference.len(),
+                "no lost or duplicated springs"
+            );
             assert!(table.len() * 2 <= table.capacity());
         }
     }

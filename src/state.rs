@@ -60,7 +60,11 @@ impl Particles {
         }
         self.radius.push(d.radius);
         self.mass.push(mass);
-        self.inertia.push(if d.fixed_rotation { f64::INFINITY } else { 0.5 * mass * d.radius * d.radius });
+        self.inertia.push(if d.fixed_rotation {
+            f64::INFINITY
+        } else {
+            0.5 * mass * d.radius * d.radius
+        });
         self.fixed.push(d.fixed);
         self.active.push(true);
         self.material.push(d.material);
@@ -82,7 +86,9 @@ impl Particles {
     }
 
     pub fn mobile_count(&self) -> usize {
-        (0..self.len()).filter(|&i| self.active[i] && !self.fixed[i]).count()
+        (0..self.len())
+            .filter(|&i| self.active[i] && !self.fixed[i])
+            .count()
     }
 
     pub fn max_radius(&self) -> f64 {

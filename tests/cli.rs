@@ -5,8 +5,15 @@ use std::path::PathBuf;
 use std::process::Command;
 
 fn talus(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_talus")).args(args).output().expect("binary runs");
-    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stdout).into(), String::from_utf8_lossy(&out.stderr).into())
+    let out = Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args(args)
+        .output()
+        .expect("binary runs");
+    (
+        out.status.code().unwrap_or(-1),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
 }
 
 fn tmp(name: &str) -> PathBuf {
@@ -29,7 +36,10 @@ fn assert_rejected(args: &[&str], must_mention: &[&str]) {
     assert_eq!(code, 2, "exit code for {args:?}; stderr: {err}");
     assert!(!err.contains("panicked"), "no panic: {err}");
     for m in must_mention {
-        assert!(err.contains(m), "error for {args:?} should mention `{m}`: {err}");
+        assert!(
+            err.contains(m),
+            "error for {args:?} should mention `{m}`: {err}"
+        );
     }
 }
 
@@ -52,14 +62,29 @@ fn wrong_type_is_named() {
 #[test]
 fn negative_radius_is_rejected() {
     let p = scene_file("radius", |v| v["particles"][0]["diameter"] = (-1.0).into());
-    assert_rejected(&["check", p.to_str().unwrap()], &["particles[0].diameter", "positive"]);
-    assert_rejected(&["check", "--set", "particles[1].diameter={\"uniform\": [-1, 1]}"], &["particles[1].diameter"]);
+    assert_rejected(
+        &["check", p.to_str().unwrap()],
+        &["particles[0].diameter", "positive"],
+    );
+    assert_rejected(
+        &[
+            "check",
+            "--set",
+            "particles[1].diameter={\"uniform\": [-1, 1]}",
+        ],
+        &["particles[1].diameter"],
+    );
 }
 
 #[test]
 fn missing_material_is_named() {
-    let p = scene_file("material", |v| v["particles"][1]["material"] = "sand".into());
-    assert_rejected(&["check", p.to_str().unwrap()], &["particles[1].material", "sand", "grain"]);
+    let p = scene_file("material", |v| {
+        v["particles"][1]["material"] = "sand".into()
+    });
+    assert_rejected(
+        &["check", p.to_str().unwrap()],
+        &["particles[1].material", "sand", "grain"],
+    );
 }
 
 #[test]
@@ -79,7 +104,10 @@ fn unreadable_or_malformed_files() {
     let p = tmp("syntax").join("s.json");
     std::fs::write(&p, "{ \"dt\": 0.1, ").unwrap();
     assert_rejected(&["check", p.to_str().unwrap()], &["not valid JSON"]);
-    assert_rejected(&["check", "--set", "particles[9].rate=1"], &["out of range"]);
+    assert_rejected(
+        &["check", "--set", "particles[9].rate=1"],
+        &["out of range"],
+    );
 }
 
 #[test]
@@ -108,11 +136,26 @@ fn diverging_run_stops_with_step_ids_and_checkpoint() {
     });
     std::fs::write(&p, scene.to_string()).unwrap();
     let out = tmp("diverge").join("out");
-    let (code, _, err) = talus(&["run", "-q", p.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        p.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
     assert_eq!(code, 1, "{err}");
-    assert!(err.contains("diverged at step") && err.contains("particles 0 and 1"), "{err}");
-    assert!(err.contains("last good checkpoint") && err.contains("ckpt_"), "{err}");
-    assert!(!out.join("summary.json").exists(), "no summary for a failed run");
+    assert!(
+        err.contains("diverged at step") && err.contains("particles 0 and 1"),
+        "{err}"
+    );
+    assert!(
+        err.contains("last good checkpoint") && err.contains("ckpt_"),
+        "{err}"
+    );
+    assert!(
+        !out.join("summary.json").exists(),
+        "no summary for a failed run"
+    );
 }
 
 #[test]

@@ -24,24 +24,50 @@ fn small_heap(extra: &[&str]) -> talus::scene::Scene {
 }
 
 fn run_to(dir: &Path, sim: &mut Simulation) {
-    run(sim, &RunOptions { out: dir.to_path_buf(), quiet: true }).expect("run succeeds");
+    run(
+        sim,
+        &RunOptions {
+            out: dir.to_path_buf(),
+            quiet: true,
+        },
+    )
+    .expect("run succeeds");
 }
 
 fn assert_same_snapshot(a: &Path, b: &Path) {
     let (sa, sb) = (snapshot::read(a).unwrap(), snapshot::read(b).unwrap());
     if a.ends_with("final.json") {
-        assert!(sa.meta.particles > 150 && sa.meta.contacts > 150, "a non-trivial state: {:?}", sa.meta.contacts);
+        assert!(
+            sa.meta.particles > 150 && sa.meta.contacts > 150,
+            "a non-trivial state: {:?}",
+            sa.meta.contacts
+        );
     }
     assert_eq!(sa.meta.step, sb.meta.step);
     for (name, ca) in &sa.columns {
         let cb = &sb.columns[name];
         let first_diff = match (ca, cb) {
-            (Column::F64(x), Column::F64(y)) => x.iter().zip(y).position(|(p, q)| p.to_bits() != q.to_bits()).or((x.len() != y.len()).then_some(0)),
-            (Column::U32(x), Column::U32(y)) => x.iter().zip(y).position(|(p, q)| p != q).or((x.len() != y.len()).then_some(0)),
-            (Column::U8(x), Column::U8(y)) => x.iter().zip(y).position(|(p, q)| p != q).or((x.len() != y.len()).then_some(0)),
+            (Column::F64(x), Column::F64(y)) => x
+                .iter()
+                .zip(y)
+                .position(|(p, q)| p.to_bits() != q.to_bits())
+                .or((x.len() != y.len()).then_some(0)),
+            (Column::U32(x), Column::U32(y)) => x
+                .iter()
+                .zip(y)
+                .position(|(p, q)| p != q)
+                .or((x.len() != y.len()).then_some(0)),
+            (Column::U8(x), Column::U8(y)) => x
+                .iter()
+                .zip(y)
+                .position(|(p, q)| p != q)
+                .or((x.len() != y.len()).then_some(0)),
             _ => Some(0),
         };
-        assert_eq!(first_diff, None, "column {name} differs at index {first_diff:?}");
+        assert_eq!(
+            first_diff, None,
+            "column {name} differs at index {first_diff:?}"
+        );
     }
 }
 
@@ -58,7 +84,10 @@ fn same_seed_gives_bitwise_identical_snapshots() {
     assert_same_snapshot(&a.join("final.json"), &b.join("final.json"));
     // A different seed must give a different heap (the test can fail).
     run_to(&c, &mut Simulation::new(small_heap(&["seed=2"])).unwrap());
-    let (fa, fc) = (snapshot::read(&a.join("final.json")).unwrap(), snapshot::read(&c.join("final.json")).unwrap());
+    let (fa, fc) = (
+        snapshot::read(&a.join("final.json")).unwrap(),
+        snapshot::read(&c.join("final.json")).unwrap(),
+    );
     assert_ne!(fa.f64("particles.x"), fc.f64("particles.x"));
     std::fs::remove_dir_all(&tmp).ok();
 }
@@ -72,9 +101,15 @@ fn resume_from_checkpoint_is_bitwise_identical() {
     let ckpt = full.join("checkpoints/ckpt_0000007500.bin");
     let mut sim = talus::checkpoint::read(&ckpt, &[]).expect("checkpoint loads");
     assert_eq!(sim.step, 7500);
-    assert!(!sim.springs.is_empty(), "the checkpoint carries tangential springs");
+    assert!(
+        !sim.springs.is_empty(),
+        "the checkpoint carries tangential springs"
+    );
     run_to(&resumed, &mut sim);
-    assert_same_snapshot(&full.join("snapshots/snap_0000011250.json"), &resumed.join("snapshots/snap_0000011250.json"));
+    assert_same_snapshot(
+        &full.join("snapshots/snap_0000011250.json"),
+        &resumed.join("snapshots/snap_0000011250.json"),
+    );
     assert_same_snapshot(&full.join("final.json"), &resumed.join("final.json"));
     std::fs::remove_dir_all(&tmp).ok();
 }
@@ -82,12 +117,17 @@ fn resume_from_checkpoint_is_bitwise_identical() {
 #[test]
 fn damaged_checkpoint_is_an_error_not_a_panic() {
     let tmp = std::env::temp_dir().join(format!("talus-bad-ckpt-{}", std::process::id()));
-    run_to(&tmp, &mut Simulation::new(small_heap(&["stop.time=2", "output.checkpoint_every=2"])).unwrap());
+    run_to(
+        &tmp,
+        &mut Simulation::new(small_heap(&["stop.time=2", "output.checkpoint_every=2"])).unwrap(),
+    );
     let ckpt = tmp.join("checkpoints/ckpt_0000001000.bin");
     let bytes = std::fs::read(&ckpt).unwrap();
     let cut = tmp.join("cut.bin");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
-    let err = talus::checkpoint::read(&cut, &[]).err().expect("truncated checkpoint is rejected");
+    let err = talus::checkpoint::read(&cut, &[])
+        .err()
+        .expect("truncated checkpoint is rejected");
     assert!(err.to_string().contains("damaged"), "{err}");
     std::fs::write(&cut, b"not a checkpoint at all").unwrap();
     assert!(talus::checkpoint::read(&cut, &[]).is_err());

@@ -18,7 +18,10 @@ fn block_on_incline(tan_theta: f64) -> (f64, f64, f64) {
         .map(|k| json!({ "position": [-40.0 + 6.0 * k as f64, 60.0 + (k % 3) as f64 * 2.0], "diameter": 1.0 }))
         .collect();
     // The block sits in the middle of the id range.
-    others.insert(6, json!({ "position": [0.0, 0.4995], "diameter": 1.0, "fixed_rotation": true }));
+    others.insert(
+        6,
+        json!({ "position": [0.0, 0.4995], "diameter": 1.0, "fixed_rotation": true }),
+    );
     let mut v = scene_value(
         json!({ "law": "spring_dashpot", "k_n": 1.0e4, "gamma_n": 20.0, "k_t": 2.0e3, "gamma_t": 10.0, "mu": MU }),
         json!([{ "kind": "list", "material": "m", "particles": others }]),
@@ -39,7 +42,11 @@ fn block_on_incline(tan_theta: f64) -> (f64, f64, f64) {
     }
     let x1 = s.particles.position(6)[0];
     let v1 = s.particles.velocity(6, s.dt())[0];
-    let k = s.pairs.iter().position(|p| p.i == 6 && p.is_wall()).expect("block touches the wall");
+    let k = s
+        .pairs
+        .iter()
+        .position(|p| p.i == 6 && p.is_wall())
+        .expect("block touches the wall");
     (x1 - x0, s.contacts[k].f_t.abs(), (v1 - v0) / t)
 }
 
@@ -50,7 +57,10 @@ fn block_sticks_below_tan_theta_equals_mu() {
     assert!(dx.abs() < 1e-9, "a sticking block creeps by {dx}");
     // Static balance along the slope: f_t = m g sin θ with m = 1.
     let expected = tan_theta.atan().sin();
-    assert!((f_t / expected - 1.0).abs() < 1e-6, "spring force {f_t} vs m g sin θ = {expected}");
+    assert!(
+        (f_t / expected - 1.0).abs() < 1e-6,
+        "spring force {f_t} vs m g sin θ = {expected}"
+    );
 }
 
 #[test]
@@ -60,8 +70,14 @@ fn block_slides_above_tan_theta_equals_mu() {
     let (dx, f_t, a) = block_on_incline(tan_theta);
     let expected = theta.sin() - MU * theta.cos();
     assert!(dx > 0.01, "a sliding block moves, dx = {dx}");
-    assert!((a / expected - 1.0).abs() < 1e-3, "acceleration {a} vs g (sin θ − μ cos θ) = {expected}");
-    assert!((f_t / (MU * theta.cos()) - 1.0).abs() < 1e-3, "friction at the Coulomb cap");
+    assert!(
+        (a / expected - 1.0).abs() < 1e-3,
+        "acceleration {a} vs g (sin θ − μ cos θ) = {expected}"
+    );
+    assert!(
+        (f_t / (MU * theta.cos()) - 1.0).abs() < 1e-3,
+        "friction at the Coulomb cap"
+    );
 }
 
 /// A free (rolling) disk on the same incline rolls without slipping for μ > tan θ / 3:
@@ -89,7 +105,15 @@ fn disk_rolls_without_slipping() {
     let v1 = s.particles.velocity(0, s.dt());
     let a = (v1[0] - v0[0]) / 1.0;
     let expected = 2.0 / 3.0 * theta.sin();
-    assert!((a / expected - 1.0).abs() < 2e-3, "rolling acceleration {a} vs {expected}");
+    assert!(
+        (a / expected - 1.0).abs() < 2e-3,
+        "rolling acceleration {a} vs {expected}"
+    );
     // rolling: v = −ω R
-    assert!((v1[0] + 0.5 * v1[2]).abs() < 1e-3 * v1[0], "no slip: v {} ω {}", v1[0], v1[2]);
+    assert!(
+        (v1[0] + 0.5 * v1[2]).abs() < 1e-3 * v1[0],
+        "no slip: v {} ω {}",
+        v1[0],
+        v1[2]
+    );
 }

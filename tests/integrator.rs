@@ -19,7 +19,8 @@ fn gear_error(dt: f64, c: &[f64; 6], zeta: f64) -> f64 {
         r.powi(k) * (phi * k as f64).cos()
     };
     let fact = [1.0, 1.0, 2.0, 6.0, 24.0, 120.0];
-    let mut q: [Dof; 6] = std::array::from_fn(|k| [lambda_pow(k as i32) * dt.powi(k as i32) / fact[k], 0.0, 0.0]);
+    let mut q: [Dof; 6] =
+        std::array::from_fn(|k| [lambda_pow(k as i32) * dt.powi(k as i32) / fact[k], 0.0, 0.0]);
     let steps = (10.0 / dt).round() as usize;
     for _ in 0..steps {
         predict_one(&mut q);
@@ -41,8 +42,15 @@ fn order(errors: &[f64]) -> Vec<f64> {
 /// scheme (leapfrog is 2, a wrong coefficient drops Gear to 2–3).
 #[test]
 fn gear_converges_at_fifth_order() {
-    for (c, zeta) in [(&CORRECTOR, 0.0), (&CORRECTOR, 0.2), (&CORRECTOR_POSITION_ONLY, 0.0)] {
-        let errors: Vec<f64> = [0.1, 0.05, 0.025, 0.0125].iter().map(|&dt| gear_error(dt, c, zeta)).collect();
+    for (c, zeta) in [
+        (&CORRECTOR, 0.0),
+        (&CORRECTOR, 0.2),
+        (&CORRECTOR_POSITION_ONLY, 0.0),
+    ] {
+        let errors: Vec<f64> = [0.1, 0.05, 0.025, 0.0125]
+            .iter()
+            .map(|&dt| gear_error(dt, c, zeta))
+            .collect();
         let p = order(&errors);
         eprintln!("c0 = {}, ζ = {zeta}: errors {errors:?}, orders {p:?}", c[0]);
         for o in &p {
@@ -110,7 +118,10 @@ fn energy_is_conserved_without_damping() {
         contacts_seen += s.pairs.len();
         worst = worst.max((total(&s) - e0).abs() / e0.abs());
     }
-    assert!(contacts_seen > 1000, "the particles must collide ({contacts_seen} contact-steps)");
+    assert!(
+        contacts_seen > 1000,
+        "the particles must collide ({contacts_seen} contact-steps)"
+    );
     eprintln!("relative energy drift {worst}");
     assert!(worst < 5e-5, "relative energy drift {worst}");
 }

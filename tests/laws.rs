@@ -21,8 +21,14 @@ fn linear_spring_dashpot_contact_time_and_restitution() {
         let r = (-eta * tc).exp();
         let law = json!({ "law": "spring_dashpot", "k_n": k, "gamma_n": gamma, "clamp": false });
         let (t, e) = head_on(law, 1.0, tc / 400.0, "gear5");
-        assert!((t / tc - 1.0).abs() < 1e-3, "η/ω0 = {eta_over_omega0}: t_c {t} vs {tc}");
-        assert!((e / r - 1.0).abs() < 1e-3, "η/ω0 = {eta_over_omega0}: r {e} vs {r}");
+        assert!(
+            (t / tc - 1.0).abs() < 1e-3,
+            "η/ω0 = {eta_over_omega0}: t_c {t} vs {tc}"
+        );
+        assert!(
+            (e / r - 1.0).abs() < 1e-3,
+            "η/ω0 = {eta_over_omega0}: r {e} vs {r}"
+        );
     }
 }
 
@@ -36,15 +42,22 @@ fn clamped_spring_dashpot_restitution_matches_its_own_analytic_value() {
     for eta_over_omega0 in [0.1, 0.3, 0.5] {
         let eta = eta_over_omega0 * omega0;
         let omega = (omega0 * omega0 - eta * eta).sqrt();
-        let wt = std::f64::consts::PI - (2.0 * eta * omega / (omega0 * omega0 - 2.0 * eta * eta)).atan();
+        let wt =
+            std::f64::consts::PI - (2.0 * eta * omega / (omega0 * omega0 - 2.0 * eta * eta)).atan();
         let t_star = wt / omega;
         let r_star = (-eta * t_star).exp() * (wt.cos() - eta / omega * wt.sin()).abs();
         let r_unclamped = (-eta * std::f64::consts::PI / omega).exp();
         let law = json!({ "law": "spring_dashpot", "k_n": k, "gamma_n": 2.0 * M12 * eta });
         // The force has a kink at t*, which costs Gear its high order there: finer dt.
         let (_, e) = head_on(law, 1.0, t_star / 4000.0, "gear5");
-        assert!((e / r_star - 1.0).abs() < 1e-3, "η/ω0 = {eta_over_omega0}: r {e} vs {r_star}");
-        assert!(e > r_unclamped, "the clamp removes the attractive pull, so less energy is lost");
+        assert!(
+            (e / r_star - 1.0).abs() < 1e-3,
+            "η/ω0 = {eta_over_omega0}: r {e} vs {r_star}"
+        );
+        assert!(
+            e > r_unclamped,
+            "the clamp removes the attractive pull, so less energy is lost"
+        );
     }
 }
 
@@ -120,5 +133,10 @@ fn equivalent_hooke_law_rests_at_its_overlap() {
     }
     let k = talus::law::continuous::equivalent_hooke_constant(36.0, 1.2, 0.915);
     let r = distance(&s, 0, 1);
-    assert!((1.0 - r - 1.0 / k).abs() < 1e-6 / k * 1e3, "overlap {} vs {}", 1.0 - r, 1.0 / k);
+    assert!(
+        (1.0 - r - 1.0 / k).abs() < 1e-6 / k * 1e3,
+        "overlap {} vs {}",
+        1.0 - r,
+        1.0 / k
+    );
 }

@@ -32,7 +32,16 @@ fn packing(seed: u64, n: usize) -> Particles {
 
 #[test]
 fn cell_list_contacts_equal_brute_force() {
-    let walls = [WallSegment { a: [0.0, 0.3], b: [30.0, 0.3] }, WallSegment { a: [0.2, 0.0], b: [0.2, 20.0] }];
+    let walls = [
+        WallSegment {
+            a: [0.0, 0.3],
+            b: [30.0, 0.3],
+        },
+        WallSegment {
+            a: [0.2, 0.0],
+            b: [0.2, 20.0],
+        },
+    ];
     let mut total = 0;
     for seed in 0..20 {
         let p = packing(seed, 300 + 37 * seed as usize);
@@ -50,5 +59,8 @@ fn cell_list_contacts_equal_brute_force() {
             }
         }
     }
-    assert!(total > 10_000, "the packings must be dense enough to test anything ({total})");
+    assert!(
+        total > 10_000,
+        "the packings must be dense enough to test anything ({total})"
+    );
 }

@@ -13,12 +13,20 @@ use crate::state::NewDisk;
 
 /// Number of rows H for a pile with L disks at the bottom.
 pub fn rows(slope: f64, bottom_row: u32) -> u32 {
-    if slope == 30.0 { (bottom_row - 1) / 3 + 1 } else { bottom_row }
+    if slope == 30.0 {
+        (bottom_row - 1) / 3 + 1
+    } else {
+        bottom_row
+    }
 }
 
 /// Disks in row M.
 pub fn row_length(slope: f64, bottom_row: u32, m: u32) -> u32 {
-    if slope == 30.0 { bottom_row - 3 * m } else { bottom_row - m }
+    if slope == 30.0 {
+        bottom_row - 3 * m
+    } else {
+        bottom_row - m
+    }
 }
 
 pub fn pile(p: &LatticePile, material: u32, rng: &mut Rng) -> Vec<NewDisk> {
@@ -38,7 +46,16 @@ pub fn pile(p: &LatticePile, material: u32, rng: &mut Rng) -> Vec<NewDisk> {
             } else {
                 d0 * (1.0 + rng.range(-0.5 * p.size_disorder, 0.5 * p.size_disorder))
             };
-            out.push(NewDisk { position: [x, z], theta: 0.0, velocity: [0.0; 2], omega: 0.0, radius: 0.5 * diameter, fixed, fixed_rotation: false, material });
+            out.push(NewDisk {
+                position: [x, z],
+                theta: 0.0,
+                velocity: [0.0; 2],
+                omega: 0.0,
+                radius: 0.5 * diameter,
+                fixed,
+                fixed_rotation: false,
+                material,
+            });
         }
     }
     out
@@ -49,7 +66,17 @@ mod tests {
     use super::*;
 
     fn spec(slope: f64, l: u32) -> LatticePile {
-        LatticePile { material: "m".into(), slope, bottom_row: l, diameter: 1.0, spacing_c: 0.0, size_disorder: 0.0, fixed_bottom: true, center_x: 0.0, base_z: 0.0 }
+        LatticePile {
+            material: "m".into(),
+            slope,
+            bottom_row: l,
+            diameter: 1.0,
+            spacing_c: 0.0,
+            size_disorder: 0.0,
+            fixed_bottom: true,
+            center_x: 0.0,
+            base_z: 0.0,
+        }
     }
 
     #[test]
@@ -67,7 +94,9 @@ mod tests {
         let mut min = f64::MAX;
         for (i, a) in disks.iter().enumerate() {
             for b in &disks[i + 1..] {
-                let d = ((a.position[0] - b.position[0]).powi(2) + (a.position[1] - b.position[1]).powi(2)).sqrt();
+                let d = ((a.position[0] - b.position[0]).powi(2)
+                    + (a.position[1] - b.position[1]).powi(2))
+                .sqrt();
                 min = min.min(d);
             }
         }

@@ -10,12 +10,20 @@ use crate::state::{NewDisk, Particles};
 
 /// Index of each material name (in the scene's sorted order).
 pub fn material_index(scene: &Scene, name: &str) -> u32 {
-    scene.materials.keys().position(|k| k == name).expect("validated material") as u32
+    scene
+        .materials
+        .keys()
+        .position(|k| k == name)
+        .expect("validated material") as u32
 }
 
 /// Adds one disk with its material's density and thickness.
 pub fn push(scene: &Scene, particles: &mut Particles, disk: &NewDisk) -> u32 {
-    let m = scene.materials.values().nth(disk.material as usize).expect("validated material");
+    let m = scene
+        .materials
+        .values()
+        .nth(disk.material as usize)
+        .expect("validated material");
     particles.push_disk(disk, m.density, m.thickness, scene.dt)
 }
 

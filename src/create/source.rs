@@ -43,7 +43,14 @@ fn is_free(particles: &Particles, p: [f64; 2], r: f64) -> bool {
 }
 
 /// The disks that source `spec` places at time `t`; at most those due by then.
-pub fn emit(spec: &PointSource, state: &mut SourceState, t: f64, material: u32, particles: &Particles, rng: &mut Rng) -> Vec<NewDisk> {
+pub fn emit(
+    spec: &PointSource,
+    state: &mut SourceState,
+    t: f64,
+    material: u32,
+    particles: &Particles,
+    rng: &mut Rng,
+) -> Vec<NewDisk> {
     let mut out = Vec::new();
     while !state.done(spec) && t >= spec.start_time + state.inserted as f64 / spec.rate {
         let [x, d] = match state.pending.take() {
@@ -59,7 +66,16 @@ pub fn emit(spec: &PointSource, state: &mut SourceState, t: f64, material: u32, 
             state.pending = Some([x, d]);
             break;
         }
-        out.push(NewDisk { position: pos, theta: 0.0, velocity: spec.velocity, omega: 0.0, radius: 0.5 * d, fixed: false, fixed_rotation: false, material });
+        out.push(NewDisk {
+            position: pos,
+            theta: 0.0,
+            velocity: spec.velocity,
+            omega: 0.0,
+            radius: 0.5 * d,
+            fixed: false,
+            fixed_rotation: false,
+            material,
+        });
         state.inserted += 1;
     }
     out

@@ -11,10 +11,24 @@ use super::{acceleration, is_integrated};
 use crate::state::{Dof, GEAR_VALUES, Particles};
 
 /// Corrector coefficients for second-order equations, velocity-dependent forces.
-pub const CORRECTOR: [f64; GEAR_VALUES] = [3.0 / 20.0, 251.0 / 360.0, 1.0, 11.0 / 18.0, 1.0 / 6.0, 1.0 / 60.0];
+pub const CORRECTOR: [f64; GEAR_VALUES] = [
+    3.0 / 20.0,
+    251.0 / 360.0,
+    1.0,
+    11.0 / 18.0,
+    1.0 / 6.0,
+    1.0 / 60.0,
+];
 
 /// Corrector coefficients for forces that depend on positions only (c0 = 3/16).
-pub const CORRECTOR_POSITION_ONLY: [f64; GEAR_VALUES] = [3.0 / 16.0, 251.0 / 360.0, 1.0, 11.0 / 18.0, 1.0 / 6.0, 1.0 / 60.0];
+pub const CORRECTOR_POSITION_ONLY: [f64; GEAR_VALUES] = [
+    3.0 / 16.0,
+    251.0 / 360.0,
+    1.0,
+    11.0 / 18.0,
+    1.0 / 6.0,
+    1.0 / 60.0,
+];
 
 /// Taylor predictor for one particle: q_k += Σ_{l>k} C(l, k) q_l.
 pub fn predict_one(q: &mut [Dof; GEAR_VALUES]) {

@@ -34,23 +34,39 @@ impl Continuous {
     pub fn from_spec(s: &ContinuousSpec, g: f64) -> Result<Self, SceneError> {
         positive("contact.n", s.n)?;
         if !(s.r0 > 1.0 && s.r0.is_finite()) {
-            return Err(SceneError::invalid("contact.r0", format!("must be greater than 1 (in units of σ), got {}", s.r0)));
+            return Err(SceneError::invalid(
+                "contact.r0",
+                format!("must be greater than 1 (in units of σ), got {}", s.r0),
+            ));
         }
         let g = force_scale(s.g, g)?;
         check_friction(s.mu, s.alpha, s.damping_fraction)?;
-        Ok(Self { elastic: Elastic::Power { n: s.n }, r0: s.r0, mu: s.mu, alpha: s.alpha, damping_fraction: s.damping_fraction, g })
+        Ok(Self {
+            elastic: Elastic::Power { n: s.n },
+            r0: s.r0,
+            mu: s.mu,
+            alpha: s.alpha,
+            damping_fraction: s.damping_fraction,
+            g,
+        })
     }
 
     pub fn from_hooke_spec(s: &HookeEquivalentSpec, g: f64) -> Result<Self, SceneError> {
         positive("contact.n", s.n)?;
         if !(s.r0 > 1.0 && s.r0.is_finite()) {
-            return Err(SceneError::invalid("contact.r0", format!("must be greater than 1, got {}", s.r0)));
+            return Err(SceneError::invalid(
+                "contact.r0",
+                format!("must be greater than 1, got {}", s.r0),
+            ));
         }
         let k = match s.k {
             Some(k) => positive("contact.k", k)?,
             None => {
                 if !(s.r_i > 0.0 && s.r_i < 1.0) {
-                    return Err(SceneError::invalid("contact.r_i", format!("must be in (0, 1) (units of σ), got {}", s.r_i)));
+                    return Err(SceneError::invalid(
+                        "contact.r_i",
+                        format!("must be in (0, 1) (units of σ), got {}", s.r_i),
+                    ));
                 }
                 equivalent_hooke_constant(s.n, s.r0, s.r_i)
             }
@@ -58,7 +74,14 @@ impl Continuous {
         let g = force_scale(s.g, g)?;
         check_friction(s.mu, s.alpha, s.damping_fraction)?;
         // The Hooke law engages at r = σ: range and δ_N use r0 = 1.
-        Ok(Self { elastic: Elastic::Hooke { k }, r0: 1.0, mu: s.mu, alpha: s.alpha, damping_fraction: s.damping_fraction, g })
+        Ok(Self {
+            elastic: Elastic::Hooke { k },
+            r0: 1.0,
+            mu: s.mu,
+            alpha: s.alpha,
+            damping_fraction: s.damping_fraction,
+            g,
+        })
     }
 
     pub fn range_factor(&self) -> f64 {
@@ -89,8 +112,14 @@ impl Continuous {
         let f_t = -spring.copysign(delta_f) - c_t * c.v_t;
         let f_t = if delta_f == 0.0 { -c_t * c.v_t } else { f_t };
 
-        let energy = self.elastic_energy(m, c.sigma, c.r) + tapered_energy(delta_f, delta_max, mu_f_e);
-        ContactOutput { f_n, f_t, history: delta_f, energy }
+        let energy =
+            self.elastic_energy(m, c.sigma, c.r) + tapered_energy(delta_f, delta_max, mu_f_e);
+        ContactOutput {
+            f_n,
+            f_t,
+            history: delta_f,
+            energy,
+        }
     }
 
     /// F_e(r), zero beyond the range.
@@ -105,7 +134,9 @@ impl Continuous {
     /// k(r) = −dF_e/dr.
     pub fn elastic_stiffness(&self, m: f64, sigma: f64, r: f64) -> f64 {
         match self.elastic {
-            Elastic::Power { n } if r < self.r0 * sigma => (n + 1.0) * m * self.g / sigma * (sigma / r).powf(n + 2.0),
+            Elastic::Power { n } if r < self.r0 * sigma => {
+                (n + 1.0) * m * self.g / sigma * (sigma / r).powf(n + 2.0)
+            }
             Elastic::Hooke { k } if r < sigma => k * m * self.g / sigma,
             _ => 0.0,
         }
@@ -117,7 +148,9 @@ impl Continuous {
             Elastic::Power { n } if r < self.r0 * sigma => {
                 m * self.g * sigma / n * ((sigma / r).powf(n) - (1.0 / self.r0).powf(n))
             }
-            Elastic::Hooke { k } if r < sigma => 0.5 * k * m * self.g / sigma * (sigma - r) * (sigma - r),
+            Elastic::Hooke { k } if r < sigma => {
+                0.5 * k * m * self.g / sigma * (sigma - r) * (sigma - r)
+            }
             _ => 0.0,
         }
     }
@@ -138,7 +171,10 @@ fn force_scale(given: Option<f64>, gravity: f64) -> Result<f64, SceneError> {
     match given {
         Some(g) => positive("contact.g", g),
         None if gravity > 0.0 => Ok(gravity),
-        None => Err(SceneError::invalid("contact.g", "is required when gravity is zero (it sets the force scale m g)")),
+        None => Err(SceneError::invalid(
+            "contact.g",
+            "is required when gravity is zero (it sets the force scale m g)",
+        )),
     }
 }
 
@@ -154,7 +190,14 @@ mod tests {
     use super::*;
 
     fn law() -> Continuous {
-        Continuous { elastic: Elastic::Power { n: 36.0 }, r0: 1.2, mu: 0.5, alpha: 1.214, damping_fraction: 0.5, g: 1.0 }
+        Continuous {
+            elastic: Elastic::Power { n: 36.0 },
+            r0: 1.2,
+            mu: 0.5,
+            alpha: 1.214,
+            damping_fraction: 0.5,
+            g: 1.0,
+        }
     }
 
     #[test]
@@ -183,10 +226,12 @@ mod tests {
         // trapezoid integral of the power law from r_i to r0
         let steps = 200_000;
         let h = (r0 - ri) / steps as f64;
-        let w: f64 = (0..steps).map(|i| {
-            let a = ri + i as f64 * h;
-            0.5 * h * (a.powf(-37.0) + (a + h).powf(-37.0))
-        }).sum();
+        let w: f64 = (0..steps)
+            .map(|i| {
+                let a = ri + i as f64 * h;
+                0.5 * h * (a.powf(-37.0) + (a + h).powf(-37.0))
+            })
+            .sum();
         assert!((0.5 * k * (1.0 - ri) * (1.0 - ri) - w).abs() < 1e-6 * w);
     }
 }

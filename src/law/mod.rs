@@ -57,15 +57,15 @@ impl ContactLaw {
     /// `g` is |gravity|, the default force scale of the continuous laws.
     pub fn from_spec(spec: &ContactSpec, g: f64) -> Result<Self, SceneError> {
         match spec {
-            ContactSpec::SpringDashpot(s) => {
-                Ok(Self::SpringDashpot(spring_dashpot::SpringDashpot::from_spec(s)?))
-            }
+            ContactSpec::SpringDashpot(s) => Ok(Self::SpringDashpot(
+                spring_dashpot::SpringDashpot::from_spec(s)?,
+            )),
             ContactSpec::Continuous(s) => {
                 Ok(Self::Continuous(continuous::Continuous::from_spec(s, g)?))
             }
-            ContactSpec::HookeEquivalent(s) => {
-                Ok(Self::Continuous(continuous::Continuous::from_hooke_spec(s, g)?))
-            }
+            ContactSpec::HookeEquivalent(s) => Ok(Self::Continuous(
+                continuous::Continuous::from_hooke_spec(s, g)?,
+            )),
         }
     }
 

@@ -9,7 +9,15 @@
 /// When the cap is reached the contact slides and the spring is shortened so that
 /// k_t |ξ| = μ f_n (paper 000 after eq. 5). With k_t = 0 it is pure viscous friction,
 /// still capped. Returns (f_t, new ξ).
-pub fn coulomb_spring(xi: f64, v_t: f64, dt: f64, k_t: f64, gamma_t: f64, mu: f64, f_n: f64) -> (f64, f64) {
+pub fn coulomb_spring(
+    xi: f64,
+    v_t: f64,
+    dt: f64,
+    k_t: f64,
+    gamma_t: f64,
+    mu: f64,
+    f_n: f64,
+) -> (f64, f64) {
     let xi = xi + v_t * dt;
     let trial = -k_t * xi - gamma_t * v_t;
     let cap = mu * f_n;
@@ -64,7 +72,10 @@ mod tests {
         assert_eq!((f, xi), (-1.0, 0.1));
         let (f, xi) = coulomb_spring(0.0, 10.0, 0.1, 10.0, 0.0, 0.5, 1.0);
         assert_eq!(f, -0.5);
-        assert!((10.0 * xi.abs() - 0.5).abs() < 1e-15, "spring shortened to the cap");
+        assert!(
+            (10.0 * xi.abs() - 0.5).abs() < 1e-15,
+            "spring shortened to the cap"
+        );
     }
 
     #[test]

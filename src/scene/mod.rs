@@ -36,7 +36,10 @@ pub enum SceneError {
 
 impl SceneError {
     pub fn invalid(path: impl Into<String>, reason: impl Into<String>) -> Self {
-        Self::Invalid { path: path.into(), reason: reason.into() }
+        Self::Invalid {
+            path: path.into(),
+            reason: reason.into(),
+        }
     }
 }
 
@@ -65,21 +68,41 @@ pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
 pub fn from_value(value: serde_json::Value) -> Result<Scene, SceneError> {
     serde_path_to_error::deserialize(value.clone()).map_err(|e| {
         let path = e.path().to_string();
-        let path = if path == "." { "scene".to_string() } else { path };
-        refine_tagged_error(&value, &path).unwrap_or_else(|| SceneError::invalid(path, e.into_inner().to_string()))
+        let path = if path == "." {
+            "scene".to_string()
+        } else {
+            path
+        };
+        refine_tagged_error(&value, &path)
+            .unwrap_or_else(|| SceneError::invalid(path, reason(e.into_inner())))
     })
+}
+
+fn reason(e: serde_json::Error) -> String {
+    e.to_string().replace(
+        "data did not match any variant of untagged enum Size",
+        "expected a diameter (a number) or {\"uniform\": [min, max]}",
+    )
 }
 
 /// serde buffers internally tagged enums (`"kind"`, `"law"`), which hides the key inside
 /// them from the path. Re-parse such a block as its variant's struct to find the key.
 fn refine_tagged_error(root: &serde_json::Value, path: &str) -> Option<SceneError> {
     use serde::de::DeserializeOwned;
-    fn inner<T: DeserializeOwned>(mut block: serde_json::Value, tag: &str, path: &str) -> Option<SceneError> {
+    fn inner<T: DeserializeOwned>(
+        mut block: serde_json::Value,
+        tag: &str,
+        path: &str,
+    ) -> Option<SceneError> {
         block.as_object_mut()?.remove(tag);
         let e = serde_path_to_error::deserialize::<_, T>(block).err()?;
         let sub = e.path().to_string();
-        let full = if sub == "." { path.to_string() } else { format!("{path}.{sub}") };
-        Some(SceneError::invalid(full, e.into_inner().to_string()))
+        let full = if sub == "." {
+            path.to_string()
+        } else {
+            format!("{path}.{sub}")
+        };
+        Some(SceneError::invalid(full, reason(e.into_inner())))
     }
     if path == "contact" {
         let block = root.get("contact")?.clone();
@@ -90,7 +113,11 @@ fn refine_tagged_error(root: &serde_json::Value, path: &str) -> Option<SceneErro
             _ => None,
         };
     }
-    let k: usize = path.strip_prefix("particles[")?.strip_suffix(']')?.parse().ok()?;
+    let k: usize = path
+        .strip_prefix("particles[")?
+        .strip_suffix(']')?
+        .parse()
+        .ok()?;
     let block = root.get("particles")?.get(k)?.clone();
     match block.get("kind")?.as_str()? {
         "lattice_pile" => inner::<LatticePile>(block, "kind", path),

@@ -23,13 +23,17 @@ pub fn apply_override(root: &mut Value, assignment: &str) -> Result<(), SceneErr
         node = match seg {
             Segment::Key(key) => {
                 let obj = node.as_object_mut().ok_or_else(|| {
-                    SceneError::invalid(path, format!("cannot set key `{key}`: not inside an object"))
+                    SceneError::invalid(
+                        path,
+                        format!("cannot set key `{key}`: not inside an object"),
+                    )
                 })?;
                 if last {
                     obj.insert(key.clone(), value);
                     return Ok(());
                 }
-                obj.entry(key.clone()).or_insert_with(|| Value::Object(Default::default()))
+                obj.entry(key.clone())
+                    .or_insert_with(|| Value::Object(Default::default()))
             }
             Segment::Index(i) => {
                 let arr = node.as_array_mut().ok_or_else(|| {
@@ -37,7 +41,10 @@ pub fn apply_override(root: &mut Value, assignment: &str) -> Result<(), SceneErr
                 })?;
                 let len = arr.len();
                 let slot = arr.get_mut(*i).ok_or_else(|| {
-                    SceneError::invalid(path, format!("index {i} is out of range (list has {len} items)"))
+                    SceneError::invalid(
+                        path,
+                        format!("index {i} is out of range (list has {len} items)"),
+                    )
                 })?;
                 if last {
                     *slot = value;

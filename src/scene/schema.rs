@@ -368,7 +368,11 @@ pub struct Output {
 
 impl Default for Output {
     fn default() -> Self {
-        Self { snapshot_every: 0.0, checkpoint_every: None, log_every: 0.0 }
+        Self {
+            snapshot_every: 0.0,
+            checkpoint_every: None,
+            log_every: 0.0,
+        }
     }
 }
 
@@ -383,7 +387,9 @@ pub struct Limits {
 
 impl Default for Limits {
     fn default() -> Self {
-        Self { max_overlap: default_max_overlap() }
+        Self {
+            max_overlap: default_max_overlap(),
+        }
     }
 }
 

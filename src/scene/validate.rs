@@ -10,11 +10,25 @@ pub const MIN_STEPS_PER_CONTACT: f64 = 5.0;
 pub const RECOMMENDED_STEPS_PER_CONTACT: f64 = 10.0;
 
 fn finite_positive(path: &str, v: f64) -> Result<(), SceneError> {
-    if v.is_finite() && v > 0.0 { Ok(()) } else { Err(SceneError::invalid(path, format!("must be positive, got {v}"))) }
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(
+            path,
+            format!("must be positive, got {v}"),
+        ))
+    }
 }
 
 fn finite_non_negative(path: &str, v: f64) -> Result<(), SceneError> {
-    if v.is_finite() && v >= 0.0 { Ok(()) } else { Err(SceneError::invalid(path, format!("must be zero or positive, got {v}"))) }
+    if v.is_finite() && v >= 0.0 {
+        Ok(())
+    } else {
+        Err(SceneError::invalid(
+            path,
+            format!("must be zero or positive, got {v}"),
+        ))
+    }
 }
 
 fn material(scene: &Scene, path: &str, name: &str) -> Result<(), SceneError> {
@@ -22,7 +36,10 @@ fn material(scene: &Scene, path: &str, name: &str) -> Result<(), SceneError> {
         Ok(())
     } else {
         let known: Vec<&str> = scene.materials.keys().map(|s| s.as_str()).collect();
-        Err(SceneError::invalid(path, format!("unknown material `{name}` (defined: {})", known.join(", "))))
+        Err(SceneError::invalid(
+            path,
+            format!("unknown material `{name}` (defined: {})", known.join(", ")),
+        ))
     }
 }
 
@@ -31,21 +48,33 @@ fn inside(scene: &Scene, path: &str, p: [f64; 2]) -> Result<(), SceneError> {
     if p[0] >= d.x[0] && p[0] <= d.x[1] && p[1] >= d.z[0] && p[1] <= d.z[1] {
         Ok(())
     } else {
-        Err(SceneError::invalid(path, format!("({}, {}) lies outside the domain", p[0], p[1])))
+        Err(SceneError::invalid(
+            path,
+            format!("({}, {}) lies outside the domain", p[0], p[1]),
+        ))
     }
 }
 
 /// Largest diameter any creation block can produce.
 pub fn max_diameter(scene: &Scene) -> f64 {
-    scene.particles.iter().map(|c| diameter_bounds(c).1).fold(0.0, f64::max)
+    scene
+        .particles
+        .iter()
+        .map(|c| diameter_bounds(c).1)
+        .fold(0.0, f64::max)
 }
 
 fn diameter_bounds(c: &Creation) -> (f64, f64) {
     match c {
-        Creation::LatticePile(p) => (p.diameter * (1.0 - 0.5 * p.size_disorder), p.diameter * (1.0 + 0.5 * p.size_disorder)),
+        Creation::LatticePile(p) => (
+            p.diameter * (1.0 - 0.5 * p.size_disorder),
+            p.diameter * (1.0 + 0.5 * p.size_disorder),
+        ),
         Creation::Row(r) => (r.diameter, r.diameter),
         Creation::PointSource(s) => s.diameter.bounds(),
-        Creation::List(l) => l.particles.iter().fold((f64::MAX, 0.0), |(lo, hi), p| (lo.min(p.diameter), hi.max(p.diameter))),
+        Creation::List(l) => l.particles.iter().fold((f64::MAX, 0.0), |(lo, hi), p| {
+            (lo.min(p.diameter), hi.max(p.diameter))
+        }),
     }
 }
 
@@ -58,13 +87,31 @@ fn material_of(c: &Creation) -> &str {
     }
 }
 
+/// Bound on 6 γ_n dt / m_min above which a warning is given.
+pub const DAMPING_STABILITY: f64 = 0.15;
+
+/// Mass of the lightest particle the scene can create.
+fn lightest_mass(scene: &Scene) -> Option<f64> {
+    scene
+        .particles
+        .iter()
+        .filter_map(|c| {
+            let (d, _) = diameter_bounds(c);
+            let m = scene.materials.get(material_of(c))?;
+            Some(m.density * std::f64::consts::PI * 0.25 * d * d * m.thickness)
+        })
+        .reduce(f64::min)
+}
+
 /// The shortest contact duration t_c = π/ω0 over the particles the scene creates: the
 /// lightest pair (m12 = m_min/2) with the law's stiffness (undamped, so conservative).
 pub fn shortest_contact_time(scene: &Scene, law: &ContactLaw) -> Option<f64> {
     let mut best: Option<f64> = None;
     for c in &scene.particles {
         let (d, _) = diameter_bounds(c);
-        let Some(m) = scene.materials.get(material_of(c)) else { continue };
+        let Some(m) = scene.materials.get(material_of(c)) else {
+            continue;
+        };
         if !(d > 0.0 && d.is_finite()) {
             continue;
         }
@@ -92,13 +139,22 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
     }
     let d = &scene.domain;
     if !(d.x[0] < d.x[1] && d.x.iter().all(|v| v.is_finite())) {
-        return Err(SceneError::invalid("domain.x", "must be [min, max] with min < max"));
+        return Err(SceneError::invalid(
+            "domain.x",
+            "must be [min, max] with min < max",
+        ));
     }
     if !(d.z[0] < d.z[1] && d.z.iter().all(|v| v.is_finite())) {
-        return Err(SceneError::invalid("domain.z", "must be [min, max] with min < max"));
+        return Err(SceneError::invalid(
+            "domain.z",
+            "must be [min, max] with min < max",
+        ));
     }
     if scene.materials.is_empty() {
-        return Err(SceneError::invalid("materials", "at least one material is required"));
+        return Err(SceneError::invalid(
+            "materials",
+            "at least one material is required",
+        ));
     }
     for (name, m) in &scene.materials {
         finite_positive(&format!("materials.{name}.density"), m.density)?;
@@ -106,11 +162,17 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
     }
     for (k, w) in scene.walls.iter().enumerate() {
         if w.from == w.to || !w.from.iter().chain(&w.to).all(|v| v.is_finite()) {
-            return Err(SceneError::invalid(format!("walls[{k}]"), "a wall needs two distinct finite end points"));
+            return Err(SceneError::invalid(
+                format!("walls[{k}]"),
+                "a wall needs two distinct finite end points",
+            ));
         }
     }
     if scene.particles.is_empty() {
-        return Err(SceneError::invalid("particles", "at least one creation block is required"));
+        return Err(SceneError::invalid(
+            "particles",
+            "at least one creation block is required",
+        ));
     }
     for (k, c) in scene.particles.iter().enumerate() {
         let at = |key: &str| format!("particles[{k}].{key}");
@@ -118,25 +180,44 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
         match c {
             Creation::LatticePile(p) => {
                 if p.slope != 30.0 && p.slope != 60.0 {
-                    return Err(SceneError::invalid(at("slope"), format!("must be 30 or 60 (degrees), got {}", p.slope)));
+                    return Err(SceneError::invalid(
+                        at("slope"),
+                        format!("must be 30 or 60 (degrees), got {}", p.slope),
+                    ));
                 }
                 if p.bottom_row < 2 {
-                    return Err(SceneError::invalid(at("bottom_row"), format!("must be at least 2, got {}", p.bottom_row)));
+                    return Err(SceneError::invalid(
+                        at("bottom_row"),
+                        format!("must be at least 2, got {}", p.bottom_row),
+                    ));
                 }
                 finite_positive(&at("diameter"), p.diameter)?;
                 if !(p.spacing_c > -0.5 && p.spacing_c < 1.0) {
-                    return Err(SceneError::invalid(at("spacing_c"), format!("must be in (-0.5, 1), got {}", p.spacing_c)));
+                    return Err(SceneError::invalid(
+                        at("spacing_c"),
+                        format!("must be in (-0.5, 1), got {}", p.spacing_c),
+                    ));
                 }
                 if !(p.size_disorder >= 0.0 && p.size_disorder < 1.0) {
-                    return Err(SceneError::invalid(at("size_disorder"), format!("must be in [0, 1), got {}", p.size_disorder)));
+                    return Err(SceneError::invalid(
+                        at("size_disorder"),
+                        format!("must be in [0, 1), got {}", p.size_disorder),
+                    ));
                 }
-                inside(scene, &at("center_x"), [p.center_x, p.base_z + 0.5 * p.diameter])?;
+                inside(
+                    scene,
+                    &at("center_x"),
+                    [p.center_x, p.base_z + 0.5 * p.diameter],
+                )?;
             }
             Creation::Row(r) => {
                 finite_positive(&at("diameter"), r.diameter)?;
                 finite_positive(&at("spacing"), r.spacing)?;
                 inside(scene, &at("start"), r.start)?;
-                let end = [r.start[0] + r.count.saturating_sub(1) as f64 * r.spacing, r.start[1]];
+                let end = [
+                    r.start[0] + r.count.saturating_sub(1) as f64 * r.spacing,
+                    r.start[1],
+                ];
                 inside(scene, &at("count"), end)?;
             }
             Creation::PointSource(s) => {
@@ -146,13 +227,23 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 finite_non_negative(&at("start_time"), s.start_time)?;
                 let (lo, hi) = s.diameter.bounds();
                 if !(lo > 0.0 && lo <= hi && hi.is_finite()) {
-                    return Err(SceneError::invalid(at("diameter"), format!("must be positive (and lo ≤ hi for a range), got {lo}..{hi}")));
+                    return Err(SceneError::invalid(
+                        at("diameter"),
+                        format!("must be positive (and lo ≤ hi for a range), got {lo}..{hi}"),
+                    ));
                 }
             }
             Creation::List(l) => {
                 for (q, p) in l.particles.iter().enumerate() {
-                    finite_positive(&format!("particles[{k}].particles[{q}].diameter"), p.diameter)?;
-                    inside(scene, &format!("particles[{k}].particles[{q}].position"), p.position)?;
+                    finite_positive(
+                        &format!("particles[{k}].particles[{q}].diameter"),
+                        p.diameter,
+                    )?;
+                    inside(
+                        scene,
+                        &format!("particles[{k}].particles[{q}].position"),
+                        p.position,
+                    )?;
                 }
             }
         }
@@ -177,6 +268,17 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                     tc / MIN_STEPS_PER_CONTACT
                 ),
             ));
+        }
+        if let (crate::law::ContactLaw::SpringDashpot(l), Some(m)) = (&law, lightest_mass(scene)) {
+            // A grain in a packing feels ~6 dashpots at once; explicit Gear goes unstable
+            // (a limit cycle, then divergence) once 6 γ_n dt / m approaches 1. Measured on
+            // the R1 pile: 0.25 oscillates forever, 0.08 settles.
+            let ratio = 6.0 * l.gamma_n * scene.dt / m;
+            if ratio > DAMPING_STABILITY {
+                warnings.push(format!(
+                    "6·gamma_n·dt/m = {ratio:.2} for the lightest particle exceeds {DAMPING_STABILITY}: strong damping may make the integrator oscillate or diverge; reduce dt or contact.gamma_n"
+                ));
+            }
         }
         if scene.dt > tc / RECOMMENDED_STEPS_PER_CONTACT {
             warnings.push(format!("dt = {} exceeds t_c/10 = {:.4e} for the stiffest contact; contacts are resolved by fewer than 10 steps", scene.dt, tc / 10.0));

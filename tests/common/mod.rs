@@ -74,5 +74,8 @@ pub fn head_on(contact: Value, v0: f64, dt: f64, integrator: &str) -> (f64, f64)
     }
     let vel = |i| s.particles.velocity(i, s.dt())[0];
     let v_out = vel(1) - vel(0);
-    (t_out.expect("separated") - t_in.expect("collided"), v_out / v0)
+    (
+        t_out.expect("separated") - t_in.expect("collided"),
+        v_out / v0,
+    )
 }
