@@ -55,9 +55,23 @@ enum Backend {
     Gpu,
 }
 
+/// A failed command: its exit code and the message printed once by `main`.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+/// Bad input: exit code 2.
+fn bad_input(message: impl ToString) -> Failure {
+    Failure {
+        code: 2,
+        message: message.to_string(),
+    }
+}
+
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {
+    let result = match cli.command {
         Command::Run {
             scene,
             out,
@@ -69,12 +83,21 @@ pub fn main() -> ExitCode {
         Command::Check { scene, overrides } => cmd_check(scene, overrides),
         Command::DefaultScene => {
             print!("{}", scene::DEFAULT_SCENE);
-            ExitCode::SUCCESS
+            Ok(())
+        }
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(f) => {
+            eprintln!("error: {}", f.message);
+            ExitCode::from(f.code)
         }
     }
 }
 
-fn load_scene(path: &Option<PathBuf>, overrides: &[String]) -> Result<scene::Scene, String> {
+/// Loads and validates a scene (the default one when no path is given), prints its
+/// warnings, and builds the initial state.
+fn build_simulation(path: &Option<PathBuf>, overrides: &[String]) -> Result<Simulation, Failure> {
     let loaded = match path {
         Some(p) => scene::load(p, overrides),
         None => scene::parse(scene::DEFAULT_SCENE, overrides),
@@ -82,37 +105,24 @@ fn load_scene(path: &Option<PathBuf>, overrides: &[String]) -> Result<scene::Sce
     let name = path
         .as_ref()
         .map_or("default scene".to_string(), |p| p.display().to_string());
-    loaded.map_err(|e| format!("error in {name}: {e}"))
-}
-
-fn cmd_check(path: Option<PathBuf>, overrides: Vec<String>) -> ExitCode {
-    let scene = match load_scene(&path, &overrides) {
-        Ok(s) => s,
-        Err(e) => {
-            eprintln!("{e}");
-            return ExitCode::from(2);
-        }
-    };
+    let scene = loaded.map_err(|e| bad_input(format!("in {name}: {e}")))?;
     for w in scene::warnings(&scene) {
         eprintln!("warning: {w}");
     }
-    match Simulation::new(scene) {
-        Ok(sim) => {
-            println!(
-                "scene `{}`: {} particles at start ({} fixed), {} steps of dt = {}",
-                sim.scene.name,
-                sim.particles.len(),
-                sim.particles.len() - sim.particles.mobile_count(),
-                run::total_steps(&sim),
-                sim.dt()
-            );
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
-        }
-    }
+    Simulation::new(scene).map_err(|e| bad_input(format!("in {name}: {e}")))
+}
+
+fn cmd_check(path: Option<PathBuf>, overrides: Vec<String>) -> Result<(), Failure> {
+    let sim = build_simulation(&path, &overrides)?;
+    println!(
+        "scene `{}`: {} particles at start ({} fixed), {} steps of dt = {}",
+        sim.scene.name,
+        sim.particles.len(),
+        sim.particles.len() - sim.particles.mobile_count(),
+        run::total_steps(&sim),
+        sim.dt()
+    );
+    Ok(())
 }
 
 fn cmd_run(
@@ -122,43 +132,21 @@ fn cmd_run(
     resume: Option<PathBuf>,
     backend: Backend,
     quiet: bool,
-) -> ExitCode {
+) -> Result<(), Failure> {
     match backend {
         Backend::Gpu => {
-            eprintln!("error: the GPU path is not implemented yet; use --backend cpu");
-            return ExitCode::from(2);
+            return Err(bad_input(
+                "the GPU path is not implemented yet; use --backend cpu",
+            ));
         }
         Backend::Auto if !quiet => {
             eprintln!("note: using the CPU reference path (the GPU path is not implemented yet)")
         }
         _ => {}
     }
-    let mut sim = if let Some(ckpt) = &resume {
-        match checkpoint::read(ckpt, &overrides) {
-            Ok(s) => s,
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(2);
-            }
-        }
-    } else {
-        let scene = match load_scene(&path, &overrides) {
-            Ok(s) => s,
-            Err(e) => {
-                eprintln!("{e}");
-                return ExitCode::from(2);
-            }
-        };
-        for w in scene::warnings(&scene) {
-            eprintln!("warning: {w}");
-        }
-        match Simulation::new(scene) {
-            Ok(s) => s,
-            Err(e) => {
-                eprintln!("error: {e}");
-                return ExitCode::from(2);
-            }
-        }
+    let mut sim = match &resume {
+        Some(ckpt) => checkpoint::read(ckpt, &overrides).map_err(bad_input)?,
+        None => build_simulation(&path, &overrides)?,
     };
     let out = out.unwrap_or_else(|| PathBuf::from("runs").join(&sim.scene.name));
     if !quiet {
@@ -171,31 +159,28 @@ fn cmd_run(
             out.display()
         );
     }
-    match run::run(
+    let s = run::run(
         &mut sim,
         &run::RunOptions {
             out: out.clone(),
             quiet,
         },
-    ) {
-        Ok(s) => {
-            if !quiet {
-                eprintln!(
-                    "done: {} steps to t = {:.4} ({}), {} particles ({} lost), {:.3e} particle-steps/s; results in {}",
-                    s.steps,
-                    s.time,
-                    if s.settled { "settled" } else { "end time" },
-                    s.particles,
-                    s.lost,
-                    s.particle_steps_per_second,
-                    out.display()
-                );
-            }
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(1)
-        }
+    )
+    .map_err(|e| Failure {
+        code: 1,
+        message: e.to_string(),
+    })?;
+    if !quiet {
+        eprintln!(
+            "done: {} steps to t = {:.4} ({}), {} particles ({} lost), {:.3e} particle-steps/s; results in {}",
+            s.steps,
+            s.time,
+            if s.settled { "settled" } else { "end time" },
+            s.particles,
+            s.lost,
+            s.particle_steps_per_second,
+            out.display()
+        );
     }
+    Ok(())
 }
