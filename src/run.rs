@@ -74,6 +74,12 @@ pub fn total_steps(sim: &Simulation) -> u64 {
 pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunError> {
     let out = &opts.out;
     std::fs::create_dir_all(out).map_err(io(out))?;
+    // A summary marks a finished run; one left by an earlier run in this folder must not
+    // vouch for this one until it has finished too.
+    let summary_path = out.join("summary.json");
+    if summary_path.exists() {
+        std::fs::remove_file(&summary_path).map_err(io(&summary_path))?;
+    }
     let scene_path = out.join("scene.json");
     let text = serde_json::to_string_pretty(&sim.scene).expect("a scene always serialises");
     write_atomic(&scene_path, text.as_bytes()).map_err(io(&scene_path))?;
@@ -205,7 +211,6 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
         final_snapshot: final_json.display().to_string(),
         last_checkpoint: checkpoints.last().map(|p| p.display().to_string()),
     };
-    let summary_path = out.join("summary.json");
     let text = serde_json::to_string_pretty(&summary).expect("summary serialises");
     write_atomic(&summary_path, text.as_bytes()).map_err(io(&summary_path))?;
     Ok(summary)

@@ -164,3 +164,59 @@ fn gpu_backend_is_reported_as_not_available() {
     assert_eq!(code, 2);
     assert!(err.contains("GPU path is not implemented"), "{err}");
 }
+
+#[test]
+fn resume_extends_a_run_and_refuses_physics_changes() {
+    let dir = tmp("resume");
+    let first = dir.join("first");
+    let common = [
+        "--set",
+        "particles[1].count=30",
+        "--set",
+        "stop.kinetic_fraction=null",
+    ];
+    let mut args = vec![
+        "run",
+        "-q",
+        "--out",
+        first.to_str().unwrap(),
+        "--set",
+        "stop.time=4",
+        "--set",
+        "output.checkpoint_every=2",
+    ];
+    args.extend(common);
+    let (code, _, err) = talus(&args);
+    assert_eq!(code, 0, "{err}");
+    let ckpt = first.join("checkpoints/ckpt_0000002000.bin");
+    let second = dir.join("second");
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--resume",
+        ckpt.to_str().unwrap(),
+        "--out",
+        second.to_str().unwrap(),
+        "--set",
+        "stop.time=6",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(second.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["time"], 6.0);
+    assert_eq!(summary["steps"], 1000);
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--resume",
+        ckpt.to_str().unwrap(),
+        "--set",
+        "contact.mu=1",
+    ]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("contact.mu") && err.contains("only stop.* and output.*"),
+        "{err}"
+    );
+}
