@@ -140,7 +140,7 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
         }
         particle_steps += active;
         let step = sim.step;
-        if log_every.is_some_and(|k| step % k == 0) {
+        if log_every.is_some_and(|k| step.is_multiple_of(k)) {
             let e = sim.energies();
             log.push_str(&format!(
                 "{step},{:.9e},{},{},{:.9e},{:.9e},{:.9e},{:.9e}\n",
@@ -153,31 +153,32 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
                 e.potential
             ));
         }
-        if snap_every.is_some_and(|k| step % k == 0) {
+        if snap_every.is_some_and(|k| step.is_multiple_of(k)) {
             snapshot::write(sim, &snap_dir, &format!("snap_{step:010}")).map_err(io(&snap_dir))?;
         }
-        if ckpt_every.is_some_and(|k| step % k == 0) {
+        if ckpt_every.is_some_and(|k| step.is_multiple_of(k)) {
             write_checkpoint(sim, &ckpt_dir, &mut checkpoints)?;
             let log_path = out.join("log.csv");
             write_atomic(&log_path, log.as_bytes()).map_err(io(&log_path))?;
         }
-        if step % check_every == 0 {
+        if step.is_multiple_of(check_every) {
             progress.update(step, sim.time(), sim.particles.active_count());
-            if let Some(frac) = sim.scene.stop.kinetic_fraction {
-                if sim.time() >= sim.scene.stop.not_before && sim.feeding_done() {
-                    let e = sim.energies();
-                    if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
-                        progress.note(&format!(
-                            "settled at t = {:.4}: kinetic/elastic = {:.3e}",
-                            sim.time(),
-                            e.kinetic() / e.elastic
-                        ));
-                        settled = true;
-                        break;
-                    }
+            if let Some(frac) = sim.scene.stop.kinetic_fraction
+                && sim.time() >= sim.scene.stop.not_before
+                && sim.feeding_done()
+            {
+                let e = sim.energies();
+                if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
+                    progress.note(&format!(
+                        "settled at t = {:.4}: kinetic/elastic = {:.3e}",
+                        sim.time(),
+                        e.kinetic() / e.elastic
+                    ));
+                    settled = true;
+                    break;
                 }
             }
-        } else if step % 256 == 0 {
+        } else if step.is_multiple_of(256) {
             progress.update(step, sim.time(), sim.particles.active_count());
         }
     }

@@ -49,7 +49,7 @@ fn reduced_r1_pile_settles_in_place() {
     let mut settled = false;
     while sim.time() < sim.scene.stop.time {
         sim.step().unwrap();
-        if sim.step % check == 0 && sim.time() >= sim.scene.stop.not_before {
+        if sim.step.is_multiple_of(check) && sim.time() >= sim.scene.stop.not_before {
             let e = sim.energies();
             if e.kinetic() < 1e-5 * e.elastic {
                 settled = true;
