@@ -42,6 +42,7 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
             }
             None => e.u8(0),
         }
+        e.u64(s.rng.state);
     }
     let p = &sim.particles;
     e.u64(p.len() as u64);
@@ -103,7 +104,14 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
         } else {
             None
         };
-        sources.push(SourceState { inserted, pending });
+        let rng = Rng {
+            state: d.u64().map_err(corrupt)?,
+        };
+        sources.push(SourceState {
+            inserted,
+            pending,
+            rng,
+        });
     }
     let n = d.u64().map_err(corrupt)? as usize;
     let mut p = Particles::default();

@@ -1,4 +1,5 @@
-//! talus: 2D granular dynamics (DEM) of disks, with a CPU reference path in f64.
+//! talus: 2D granular dynamics (DEM) of disks: a GPU path (WGSL kernels on wgpu, `gpu`)
+//! and a CPU reference path in f64 that it is tested against.
 //!
 //! The step is a sequence of stages (see ARCHITECTURE.md): predict → cell list
 //! (`cell_index`, `cell_histogram`, `prefix_sum`, `scatter`) → `find_contacts` →
@@ -12,6 +13,7 @@ pub mod create;
 pub mod files;
 pub mod forces;
 pub mod geometry;
+pub mod gpu;
 pub mod integrate;
 pub mod law;
 pub mod progress;

@@ -20,6 +20,12 @@ pub enum Divergence {
     #[error("particle {id} has a non-finite {what}")]
     NotFinite { id: u32, what: &'static str },
     #[error(
+        "particle {id} has more than {max} contacts (a GPU buffer limit; overlaps this large mean the run is diverging)"
+    )]
+    TooManyContacts { id: u32, max: u32 },
+    #[error("the GPU spring table is full (particle {id})")]
+    SpringTableFull { id: u32 },
+    #[error(
         "particles {i} and {j} overlap by {ratio:.3} of the smaller radius (limits.max_overlap = {limit})"
     )]
     Overlap {
@@ -47,6 +53,7 @@ impl Energies {
     }
 }
 
+#[derive(Clone)]
 pub struct Simulation {
     pub scene: Scene,
     pub law: ContactLaw,
@@ -59,6 +66,8 @@ pub struct Simulation {
     pub step: u64,
     /// Particles removed for leaving the domain.
     pub lost: u64,
+    /// The exact device state when this state came from (or goes to) the GPU path.
+    pub device_state: Option<crate::gpu::DeviceState>,
     // Per-step buffers, rebuilt every step (not part of the state).
     pub cells: CellList,
     pub pairs: Vec<Pair>,
@@ -77,7 +86,8 @@ impl Simulation {
             .particles
             .iter()
             .filter(|c| matches!(c, Creation::PointSource(_)))
-            .map(|_| SourceState::default())
+            .enumerate()
+            .map(|(k, _)| SourceState::new(scene.seed, k))
             .collect();
         let mut sim =
             Self::from_parts(scene, particles, SpringTable::default(), sources, rng, 0, 0)?;
@@ -120,6 +130,7 @@ impl Simulation {
             rng,
             step,
             lost,
+            device_state: None,
             cells: CellList::default(),
             pairs: Vec::new(),
             contacts: Vec::new(),
@@ -228,7 +239,6 @@ impl Simulation {
                 t,
                 material,
                 &self.particles,
-                &mut self.rng,
             );
             for d in disks {
                 let id = create::push(&self.scene, &mut self.particles, &d) as usize;

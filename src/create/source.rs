@@ -1,24 +1,88 @@
 //! Point sources (paper 001 sec. II, paper 000 sec. 5.3): particle k of a source appears
 //! at t = start + k/rate at the outlet, x uniform within ±spread, with the initial
-//! velocity. If the spot is taken, the same drawn particle waits for a later step, so the
-//! random stream (and with it the run) stays deterministic.
+//! velocity. If the spot is taken, the same drawn particle waits for a later step. Each
+//! source draws from its own random stream, so candidate k of a source is fixed by the
+//! seed alone: only *when* it is placed depends on the state. The GPU path relies on
+//! this to draw the candidates on the host ahead of time ([`upcoming`]).
 
 use crate::rng::Rng;
 use crate::scene::PointSource;
 use crate::state::{NewDisk, Particles};
 
+/// At most this many particles of one source are placed in one step (the GPU's
+/// `INSERT_WINDOW`; both paths use it so that they insert on the same steps).
+pub const MAX_PER_STEP: u32 = 4;
+
 /// Progress of one source; part of the checkpoint.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct SourceState {
     pub inserted: u32,
     /// A particle drawn but not yet placed: (x, diameter).
     pub pending: Option<[f64; 2]>,
+    /// The source's own random stream.
+    pub rng: Rng,
 }
 
 impl SourceState {
+    /// The state of source number `index` (in scene order) of a run seeded with `seed`.
+    pub fn new(seed: u64, index: usize) -> Self {
+        let mut mix = Rng::new(seed ^ (index as u64 + 1).wrapping_mul(0xD1B5_4A32_D192_ED03));
+        Self {
+            inserted: 0,
+            pending: None,
+            rng: Rng::new(mix.next_u64()),
+        }
+    }
+
     pub fn done(&self, spec: &PointSource) -> bool {
         self.inserted >= spec.count
     }
+}
+
+/// The candidates (x, diameter) a source will place next, in order: the pending one,
+/// then fresh draws, up to the source's count.
+pub fn upcoming(spec: &PointSource, state: &SourceState) -> Vec<[f64; 2]> {
+    let left = spec.count.saturating_sub(state.inserted) as usize;
+    let mut rng = state.rng.clone();
+    let mut out: Vec<[f64; 2]> = state.pending.into_iter().collect();
+    while out.len() < left {
+        out.push(draw(spec, &mut rng));
+    }
+    out.truncate(left);
+    out
+}
+
+/// The state after `placed` more particles of `upcoming(spec, state)` are placed (and
+/// none is pending).
+pub fn advanced(spec: &PointSource, state: &SourceState, placed: u32) -> SourceState {
+    let mut s = state.clone();
+    for _ in 0..placed {
+        match s.pending.take() {
+            Some(_) => {}
+            None => {
+                draw(spec, &mut s.rng);
+            }
+        }
+        s.inserted += 1;
+    }
+    s
+}
+
+/// The first step whose time step·dt reaches `t` (the test `t_step >= t` of [`emit`]).
+pub fn due_step(t: f64, dt: f64) -> u64 {
+    let mut s = (t / dt).ceil().max(0.0) as u64;
+    while s > 0 && (s - 1) as f64 * dt >= t {
+        s -= 1;
+    }
+    while (s as f64 * dt) < t {
+        s += 1;
+    }
+    s
+}
+
+/// Time at which particle k of a source is due.
+pub fn due_time(spec: &PointSource, k: u32) -> f64 {
+    spec.start_time + k as f64 / spec.rate
 }
 
 /// Draws the next particle of a source: (x, diameter).
@@ -49,13 +113,15 @@ pub fn emit(
     t: f64,
     material: u32,
     particles: &Particles,
-    rng: &mut Rng,
 ) -> Vec<NewDisk> {
     let mut out = Vec::new();
-    while !state.done(spec) && t >= spec.start_time + state.inserted as f64 / spec.rate {
+    while !state.done(spec)
+        && t >= due_time(spec, state.inserted)
+        && (out.len() as u32) < MAX_PER_STEP
+    {
         let [x, d] = match state.pending.take() {
             Some(p) => p,
-            None => draw(spec, rng),
+            None => draw(spec, &mut state.rng),
         };
         let pos = [x, spec.position[1]];
         let fresh_ok = out.iter().all(|o: &NewDisk| {

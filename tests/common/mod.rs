@@ -79,3 +79,16 @@ pub fn head_on(contact: Value, v0: f64, dt: f64, integrator: &str) -> (f64, f64)
         v_out / v0,
     )
 }
+
+/// A GPU device for a test, or None (with a message) when there is no adapter, unless
+/// TALUS_REQUIRE_GPU=1 (CI), where a missing adapter fails the test.
+pub fn gpu(test: &str) -> Option<talus::gpu::device::Gpu> {
+    match talus::gpu::device::Gpu::open() {
+        Ok(g) => Some(g),
+        Err(e) if !talus::gpu::device::gpu_required() => {
+            eprintln!("SKIPPED {test}: {e} (set TALUS_REQUIRE_GPU=1 to make this a failure)");
+            None
+        }
+        Err(e) => panic!("TALUS_REQUIRE_GPU=1 and {test} has no GPU: {e}"),
+    }
+}

@@ -1,0 +1,19 @@
+// Stage 1 of the counting sort (src/cell_list.rs `cell_index`): the cell of each active
+// particle. The anchor *is* the cell, clamped into the grid. Also clears the per-step
+// counters of the later stages.
+
+@compute @workgroup_size(WG)
+fn clear_cells(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let c = gid.x;
+    if (c < params.cells) { atomicStore(&cell_count[c], 0u); }
+    if (c < params.n_cap) { atomicStore(&down_count[c], 0u); }
+}
+
+@compute @workgroup_size(WG)
+fn cell_index(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.n_cap) { return; }
+    if (i >= live() || !is_active(i)) { cell_of[i] = EMPTY; return; }
+    let c = cell_coords(state[i].anchor);
+    cell_of[i] = c.y * params.nx + c.x;
+}

@@ -1,0 +1,248 @@
+// Shared declarations of every talus kernel: constants, the data layouts and the
+// bindings. The Rust twins of these structs are in src/gpu/layout.rs; a test checks the
+// sizes and field offsets against naga's view of this file.
+//
+// Precision (SPEC 3, issue 3): a position is an integer cell `anchor` plus an f32
+// offset `frac` in [0, cell_size). The vector between two particles is
+// (anchor_i - anchor_j) * cell_size + (frac_i - frac_j): the integer difference of
+// neighbours is small and exact, the offsets are both below one cell, so the result
+// carries f32's relative precision (6e-8 of a diameter) wherever the pair sits in the
+// domain. Absolute f32 positions would lose 1e-3 of a diameter at 10^4 diameters.
+
+const WG: u32 = 64u;
+// Contacts per particle as the lower id (its own list) and as the higher id.
+const MAX_CONTACTS: u32 = 16u;
+const WALL_BASE: u32 = 0xFFFF0000u;
+const EMPTY: u32 = 0xFFFFFFFFu;
+// Props.flags
+const ACTIVE: u32 = 1u;
+const FIXED: u32 = 2u;
+// control[] words
+const C_STEP: u32 = 0u;
+const C_LIVE: u32 = 1u;
+const C_LOST: u32 = 2u;
+const C_HALT: u32 = 3u;
+const C_HALT_STEP: u32 = 4u;
+const C_HALT_ID: u32 = 5u;
+const C_BLOCKED: u32 = 8u;
+// Halt reasons (bits of control[C_HALT]).
+const HALT_OVERLAP: u32 = 1u;
+const HALT_NOT_FINITE: u32 = 2u;
+const HALT_CONTACTS_FULL: u32 = 4u;
+const HALT_TABLE_FULL: u32 = 8u;
+// Candidates of one source looked at per step.
+const INSERT_WINDOW: u32 = 4u;
+
+struct Params {
+    n_cap: u32,
+    nx: u32,
+    nz: u32,
+    cells: u32,
+    n_walls: u32,
+    n_sources: u32,
+    table_mask: u32,
+    integrator: u32,   // 0 Gear, 1 leapfrog
+    cell_size: f32,
+    dt: f32,
+    max_overlap: f32,
+    range_factor: f32,
+    gx: f32,
+    gz: f32,
+    ramp_steps: f32,   // gravity ramp in steps; 0: none
+    law: u32,          // 0 spring-dashpot, 1 continuous
+    dom_lo_x: f32,     // domain, relative to the grid origin
+    dom_lo_z: f32,
+    dom_hi_x: f32,
+    dom_hi_z: f32,
+    // spring-dashpot (paper 000 eq. 2-5)
+    k_n: f32,
+    nu: f32,
+    psi: f32,
+    delta0: f32,
+    gamma_n: f32,
+    k_t: f32,
+    gamma_t: f32,
+    mu: f32,
+    clamp: u32,
+    // continuous (paper 001 eq. 3-8)
+    elastic: u32,      // 0 power law, 1 Hooke
+    n_exp: f32,
+    hooke_k: f32,
+    r0: f32,
+    alpha: f32,
+    damping_fraction: f32,
+    g_scale: f32,
+    // prefix sum: blocks of level 1 and where level 2 starts in `scan`
+    scan_blocks1: u32,
+    scan_blocks2: u32,
+    scan_offset2: u32,
+    _pad: u32,
+};
+
+// Dynamic state: q[0] = (frac_x, frac_z, theta, 0), q[k] = (dt^k/k!) d^k/dt^k.
+struct State {
+    q: array<vec4<f32>, 6>,
+    anchor: vec2<i32>,
+    _pad: vec2<u32>,
+};
+
+struct Props {
+    radius: f32,
+    mass: f32,
+    inv_inertia: f32,   // 0 for fixed rotation
+    flags: u32,         // ACTIVE | FIXED | material << 8
+};
+
+struct ContactOut {
+    // (f_x, f_z) on i, torque on i, torque on j
+    ft: vec4<f32>,
+    // f_n, f_t, overlap, elastic energy
+    info: vec4<f32>,
+};
+
+struct Wall {
+    anchor: vec2<i32>,
+    frac: vec2<f32>,
+    ab: vec2<f32>,
+    _pad: vec2<f32>,
+};
+
+struct Entry {
+    i: atomic<u32>,
+    j: u32,
+    value: f32,
+    _pad: u32,
+};
+
+struct Source {
+    first: u32,      // index of its first candidate
+    count: u32,
+    inserted: u32,
+    _pad: u32,
+};
+
+struct Candidate {
+    anchor: vec2<i32>,
+    frac: vec2<f32>,
+    velocity: vec2<f32>,  // scaled: dt * v
+    radius: f32,
+    mass: f32,
+    inv_inertia: f32,
+    due_step: u32,
+    flags: u32,
+    _pad: u32,
+};
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read_write> state: array<State>;
+@group(0) @binding(2) var<storage, read_write> props: array<Props>;
+@group(0) @binding(3) var<storage, read_write> cell_of: array<u32>;
+@group(0) @binding(4) var<storage, read_write> cell_count: array<atomic<u32>>;
+@group(0) @binding(5) var<storage, read_write> cell_start: array<u32>;
+@group(0) @binding(6) var<storage, read_write> scan: array<u32>;
+@group(0) @binding(7) var<storage, read_write> sorted: array<u32>;
+@group(0) @binding(8) var<storage, read_write> contact_j: array<u32>;
+@group(0) @binding(9) var<storage, read_write> contact_count: array<u32>;
+@group(0) @binding(10) var<storage, read_write> down: array<u32>;
+@group(0) @binding(11) var<storage, read_write> down_count: array<atomic<u32>>;
+@group(0) @binding(12) var<storage, read_write> hist_in: array<f32>;
+@group(0) @binding(13) var<storage, read_write> hist_out: array<f32>;
+@group(0) @binding(14) var<storage, read_write> contact_out: array<ContactOut>;
+@group(0) @binding(15) var<storage, read_write> force: array<vec4<f32>>;
+@group(0) @binding(16) var<storage, read_write> walls: array<Wall>;
+@group(0) @binding(17) var<storage, read_write> control: array<atomic<u32>>;
+@group(0) @binding(18) var<storage, read_write> sources: array<Source>;
+@group(0) @binding(19) var<storage, read_write> candidates: array<Candidate>;
+// The spring table of the previous step (read) and of this step (written); the host
+// swaps the two buffers every step.
+@group(1) @binding(0) var<storage, read_write> table_old: array<Entry>;
+@group(1) @binding(1) var<storage, read_write> table_new: array<Entry>;
+
+fn is_active(i: u32) -> bool {
+    return (props[i].flags & ACTIVE) != 0u;
+}
+
+fn is_fixed(i: u32) -> bool {
+    return (props[i].flags & FIXED) != 0u;
+}
+
+fn is_integrated(i: u32) -> bool {
+    return (props[i].flags & (ACTIVE | FIXED)) == ACTIVE;
+}
+
+fn halted() -> bool {
+    return atomicLoad(&control[C_HALT]) != 0u;
+}
+
+fn live() -> u32 {
+    return atomicLoad(&control[C_LIVE]);
+}
+
+// Stops the run: the first step and the lowest particle id are kept (atomic min, so the
+// report does not depend on thread timing).
+fn halt(reason: u32, id: u32) {
+    atomicOr(&control[C_HALT], reason);
+    atomicMin(&control[C_HALT_STEP], atomicLoad(&control[C_STEP]));
+    atomicMin(&control[C_HALT_ID], id);
+}
+
+// Vector from point (aj, fj) to point (ai, fi), exact up to one f32 rounding of the
+// result (see the precision note at the top).
+fn rel(ai: vec2<i32>, fi: vec2<f32>, aj: vec2<i32>, fj: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(ai - aj) * params.cell_size + (fi - fj);
+}
+
+fn rel_ij(i: u32, j: u32) -> vec2<f32> {
+    return rel(state[i].anchor, state[i].q[0].xy, state[j].anchor, state[j].q[0].xy);
+}
+
+// Moves whole cells from the offset into the anchor so that 0 <= frac < cell_size.
+fn renormalize(s: ptr<function, State>) {
+    let l = params.cell_size;
+    for (var d = 0u; d < 2u; d++) {
+        var f = (*s).q[0][d];
+        var a = (*s).anchor[d];
+        let c = floor(f / l);
+        a += i32(c);
+        f -= c * l;
+        if (f >= l) { f -= l; a += 1; }
+        if (f < 0.0) { f += l; a -= 1; }
+        (*s).q[0][d] = f;
+        (*s).anchor[d] = a;
+    }
+}
+
+// Gravity at the given step (ramped linearly, paper 000 sec. 4).
+fn gravity_at(step: f32) -> vec2<f32> {
+    var s = 1.0;
+    if (params.ramp_steps > 0.0) {
+        s = min(step / params.ramp_steps, 1.0);
+    }
+    return vec2<f32>(params.gx, params.gz) * s;
+}
+
+// Cell coordinates of an anchor, clamped into the grid (as Grid::cell_coords).
+fn cell_coords(a: vec2<i32>) -> vec2<u32> {
+    let cx = clamp(a.x, 0, i32(params.nx) - 1);
+    let cz = clamp(a.y, 0, i32(params.nz) - 1);
+    return vec2<u32>(u32(cx), u32(cz));
+}
+
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+fn tangent(n: vec2<f32>) -> vec2<f32> {
+    return vec2<f32>(-n.y, n.x);
+}
+
+// Slot hash of a pair for the spring table (murmur3's 32-bit finaliser over both ids).
+fn hash_pair(i: u32, j: u32) -> u32 {
+    var h = (i * 0x9E3779B1u) ^ ((j + 0x7F4A7C15u) * 0x85EBCA77u);
+    h ^= h >> 16u;
+    h *= 0x7FEB352Du;
+    h ^= h >> 15u;
+    h *= 0x846CA68Bu;
+    h ^= h >> 16u;
+    return h;
+}

@@ -1,0 +1,31 @@
+// Stage: Gear corrector (src/integrate/gear.rs `correct`), c0 = 3/20 for
+// velocity-dependent forces (Allen & Tildesley).
+
+
+fn acceleration(i: u32, g: vec2<f32>) -> vec4<f32> {
+    let f = force[i];
+    return vec4<f32>(f.xy / props[i].mass + g, f.z * props[i].inv_inertia, 0.0);
+}
+
+fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
+    let half_dt2 = 0.5 * params.dt * params.dt;
+    let delta = half_dt2 * accel - (*s).q[2];
+    (*s).q[0] += (3.0 / 20.0) * delta;
+    (*s).q[1] += (251.0 / 360.0) * delta;
+    (*s).q[2] += delta;
+    (*s).q[3] += (11.0 / 18.0) * delta;
+    (*s).q[4] += (1.0 / 6.0) * delta;
+    (*s).q[5] += (1.0 / 60.0) * delta;
+}
+
+@compute @workgroup_size(WG)
+fn correct(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= live() || halted() || !is_integrated(i)) { return; }
+    // Forces were evaluated at the predicted state, i.e. at time t + dt.
+    let g = gravity_at(f32(atomicLoad(&control[C_STEP]) + 1u));
+    var s = state[i];
+    correct_one(&s, acceleration(i, g));
+    renormalize(&s);
+    state[i] = s;
+}

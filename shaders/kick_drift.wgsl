@@ -1,0 +1,20 @@
+// Stage: leapfrog (src/integrate/leapfrog.rs `kick_drift`), paper 001 eq. 9-12, with
+// q1 = dt v(t - dt/2).
+
+fn acceleration(i: u32, g: vec2<f32>) -> vec4<f32> {
+    let f = force[i];
+    return vec4<f32>(f.xy / props[i].mass + g, f.z * props[i].inv_inertia, 0.0);
+}
+
+@compute @workgroup_size(WG)
+fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= live() || halted() || !is_integrated(i)) { return; }
+    let g = gravity_at(f32(atomicLoad(&control[C_STEP])));
+    var s = state[i];
+    let a = acceleration(i, g);
+    s.q[1] += a * params.dt * params.dt;
+    s.q[0] += s.q[1];
+    renormalize(&s);
+    state[i] = s;
+}

@@ -1,0 +1,142 @@
+// Contact laws (src/law/*.rs), line for line in f32. Coefficients come from the host's
+// f64 ContactLaw through Params.
+
+struct ContactInput {
+    delta: f32,
+    r: f32,
+    sigma: f32,
+    delta_dot: f32,
+    v_t: f32,
+    m12: f32,
+    mass: f32,
+    history: f32,
+    dt: f32,
+};
+
+struct ContactOutput {
+    f_n: f32,
+    f_t: f32,
+    history: f32,
+    energy: f32,
+};
+
+fn pow_pos(x: f32, y: f32) -> f32 {
+    if (x <= 0.0) { return 0.0; }
+    return pow(x, y);
+}
+
+// f_el = k_n delta0 (delta/delta0)^nu, paper 000 eq. 2.
+fn elastic_force(delta: f32) -> f32 {
+    if (params.nu == 1.0) { return params.k_n * delta; }
+    return params.k_n * params.delta0 * pow_pos(delta / params.delta0, params.nu);
+}
+
+// f_diss = gamma_n delta_dot (delta/delta0)^psi, paper 000 eq. 3.
+fn dissipative_force(delta: f32, delta_dot: f32) -> f32 {
+    if (params.psi == 0.0) { return params.gamma_n * delta_dot; }
+    return params.gamma_n * delta_dot * pow_pos(delta / params.delta0, params.psi);
+}
+
+fn elastic_energy(delta: f32) -> f32 {
+    let nu = params.nu;
+    return params.k_n * params.delta0 * params.delta0
+        * pow_pos(delta / params.delta0, nu + 1.0) / (nu + 1.0);
+}
+
+// Coulomb-capped spring, paper 000 eq. 4-5: returns (f_t, new xi).
+fn coulomb_spring(xi0: f32, v_t: f32, dt: f32, f_n: f32) -> vec2<f32> {
+    let xi = xi0 + v_t * dt;
+    let trial = -params.k_t * xi - params.gamma_t * v_t;
+    let cap = params.mu * f_n;
+    if (abs(trial) <= cap) { return vec2<f32>(trial, xi); }
+    let f_t = select(-cap, cap, trial >= 0.0);
+    var xs = 0.0;
+    if (params.k_t > 0.0) { xs = -f_t / params.k_t; }
+    return vec2<f32>(f_t, xs);
+}
+
+fn spring_dashpot(c: ContactInput) -> ContactOutput {
+    let f_el = elastic_force(c.delta);
+    let f_diss = dissipative_force(c.delta, c.delta_dot);
+    var f_n = f_el + f_diss;
+    if (params.clamp != 0u) { f_n = max(f_n, 0.0); }
+    let t = coulomb_spring(c.history, c.v_t, c.dt, f_n);
+    let energy = elastic_energy(c.delta) + 0.5 * params.k_t * t.y * t.y;
+    return ContactOutput(f_n, t.x, t.y, energy);
+}
+
+// Tapered friction, paper 001 eq. 5, and its stiffness, eq. 7.
+fn tapered_friction(delta_f: f32, delta_max: f32, mu_f_n: f32) -> f32 {
+    if (delta_max <= 0.0) { return 0.0; }
+    let u = min(abs(delta_f) / delta_max, 1.0);
+    return mu_f_n * (1.0 - pow_pos(1.0 - u, 1.5));
+}
+
+fn tapered_stiffness(delta_f: f32, delta_max: f32, mu_f_n: f32) -> f32 {
+    if (delta_max <= 0.0) { return 0.0; }
+    let u = min(abs(delta_f) / delta_max, 1.0);
+    return 1.5 * mu_f_n / delta_max * sqrt(1.0 - u);
+}
+
+fn tapered_energy(delta_f: f32, delta_max: f32, mu_f_n: f32) -> f32 {
+    if (delta_max <= 0.0) { return 0.0; }
+    let x = min(abs(delta_f), delta_max);
+    return mu_f_n * (x + 0.4 * delta_max * (pow_pos(1.0 - x / delta_max, 2.5) - 1.0));
+}
+
+fn continuous_force(m: f32, sigma: f32, r: f32) -> f32 {
+    if (params.elastic == 0u) {
+        if (r < params.r0 * sigma) { return m * params.g_scale * pow(sigma / r, params.n_exp + 1.0); }
+    } else if (r < sigma) {
+        return params.hooke_k * m * params.g_scale / sigma * (sigma - r);
+    }
+    return 0.0;
+}
+
+fn continuous_stiffness(m: f32, sigma: f32, r: f32) -> f32 {
+    if (params.elastic == 0u) {
+        if (r < params.r0 * sigma) {
+            return (params.n_exp + 1.0) * m * params.g_scale / sigma * pow(sigma / r, params.n_exp + 2.0);
+        }
+    } else if (r < sigma) {
+        return params.hooke_k * m * params.g_scale / sigma;
+    }
+    return 0.0;
+}
+
+fn continuous_energy(m: f32, sigma: f32, r: f32) -> f32 {
+    if (params.elastic == 0u) {
+        if (r < params.r0 * sigma) {
+            let n = params.n_exp;
+            return m * params.g_scale * sigma / n * (pow(sigma / r, n) - pow(1.0 / params.r0, n));
+        }
+    } else if (r < sigma) {
+        return 0.5 * params.hooke_k * m * params.g_scale / sigma * (sigma - r) * (sigma - r);
+    }
+    return 0.0;
+}
+
+// Continuous interaction with tapered friction, paper 001 eq. 3-8.
+fn continuous(c: ContactInput) -> ContactOutput {
+    let m = c.mass;
+    let f_e = continuous_force(m, c.sigma, c.r);
+    let k = continuous_stiffness(m, c.sigma, c.r);
+    let c_n = params.damping_fraction * 2.0 * sqrt(m * k);       // eq. 3
+    let f_n = max(f_e + c_n * c.delta_dot, 0.0);
+    let delta_n = max(params.r0 * c.sigma - c.r, 0.0);
+    let delta_max = params.alpha * params.mu * delta_n;
+    let delta_f = clamp(c.history + c.v_t * c.dt, -delta_max, delta_max);  // eq. 6
+    let mu_f_e = params.mu * f_e;
+    let spring = tapered_friction(delta_f, delta_max, mu_f_e);
+    let k_t = tapered_stiffness(delta_f, delta_max, mu_f_e);
+    let c_t = params.damping_fraction * 2.0 * sqrt(m * k_t);     // eq. 8
+    var f_t = -spring * sign(delta_f) - c_t * c.v_t;
+    if (delta_f == 0.0) { f_t = -c_t * c.v_t; }
+    let energy = continuous_energy(m, c.sigma, c.r) + tapered_energy(delta_f, delta_max, mu_f_e);
+    return ContactOutput(f_n, f_t, delta_f, energy);
+}
+
+fn evaluate(c: ContactInput) -> ContactOutput {
+    if (params.law == 0u) { return spring_dashpot(c); }
+    return continuous(c);
+}

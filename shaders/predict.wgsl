@@ -1,0 +1,25 @@
+// Stage: Gear predictor (src/integrate/gear.rs `predict`): a Taylor step of the six
+// scaled derivatives, q_k += sum_{l>k} C(l, k) q_l.
+
+fn predict_one(s: ptr<function, State>) {
+    let q1 = (*s).q[1];
+    let q2 = (*s).q[2];
+    let q3 = (*s).q[3];
+    let q4 = (*s).q[4];
+    let q5 = (*s).q[5];
+    (*s).q[0] += q1 + q2 + q3 + q4 + q5;
+    (*s).q[1] += 2.0 * q2 + 3.0 * q3 + 4.0 * q4 + 5.0 * q5;
+    (*s).q[2] += 3.0 * q3 + 6.0 * q4 + 10.0 * q5;
+    (*s).q[3] += 4.0 * q4 + 10.0 * q5;
+    (*s).q[4] += 5.0 * q5;
+}
+
+@compute @workgroup_size(WG)
+fn predict(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= live() || halted() || !is_integrated(i)) { return; }
+    var s = state[i];
+    predict_one(&s);
+    renormalize(&s);
+    state[i] = s;
+}

@@ -1,0 +1,28 @@
+// Stage (src/forces.rs `reduce_forces`): each particle sums its own contacts' forces in
+// a fixed order, with no float atomics: first the contacts where it is the higher id
+// (sorted by the lower id, as they come in the CPU's contact list), then its own.
+
+@compute @workgroup_size(WG)
+fn reduce_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let p = gid.x;
+    if (p >= live() || halted()) { return; }
+    var acc = vec3<f32>(0.0);
+    let nd = min(atomicLoad(&down_count[p]), MAX_CONTACTS);
+    var slots: array<u32, MAX_CONTACTS>;
+    for (var a = 0u; a < nd; a++) {
+        let s = down[p * MAX_CONTACTS + a];
+        var k = a;
+        while (k > 0u && slots[k - 1u] > s) { slots[k] = slots[k - 1u]; k--; }
+        slots[k] = s;
+    }
+    for (var a = 0u; a < nd; a++) {
+        let ft = contact_out[slots[a]].ft;
+        acc -= vec3<f32>(ft.xy, 0.0);
+        acc.z += ft.w;
+    }
+    for (var k = 0u; k < contact_count[p]; k++) {
+        let ft = contact_out[p * MAX_CONTACTS + k].ft;
+        acc += ft.xyz;
+    }
+    force[p] = vec4<f32>(acc, 0.0);
+}

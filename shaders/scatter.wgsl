@@ -1,0 +1,20 @@
+// Stage 4 (src/cell_list.rs `scatter`): particle ids into cell order. The slot within a
+// cell comes from an atomic counter, so the order *within* a cell varies from run to
+// run; nothing downstream depends on it, because find_contacts sorts each particle's
+// contacts by partner id. The counts are reset by scan_level0's reader, so they are
+// reused here as the per-cell cursor after being cleared.
+
+@compute @workgroup_size(WG)
+fn clear_cursor(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let c = gid.x;
+    if (c < params.cells) { atomicStore(&cell_count[c], 0u); }
+}
+
+@compute @workgroup_size(WG)
+fn scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= params.n_cap || cell_of[i] == EMPTY) { return; }
+    let c = cell_of[i];
+    let slot = cell_start[c] + atomicAdd(&cell_count[c], 1u);
+    sorted[slot] = i;
+}

@@ -1,0 +1,200 @@
+//! Adapter discovery and device creation (issue 3, SPEC 7 `talus info`).
+//!
+//! talus uses only wgpu's Vulkan backend: it is what lavapipe (Mesa's software driver,
+//! used in CI) and the NVIDIA/AMD/Intel drivers of our users' workstations share, so one
+//! backend is tested everywhere the code runs.
+
+use std::fmt::Write as _;
+
+/// Which path a run uses (`--backend`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum BackendChoice {
+    /// A GPU adapter when one exists, else the CPU path with a notice.
+    Auto,
+    Cpu,
+    Gpu,
+}
+
+/// Storage buffers bound at once by the largest kernel (see `shaders/common.wgsl`).
+pub const STORAGE_BUFFERS_NEEDED: u32 = 21;
+
+#[derive(Debug, thiserror::Error)]
+pub enum DeviceError {
+    #[error(
+        "no GPU adapter found (talus needs a Vulkan driver; on a machine without a GPU, \
+         install Mesa's software driver: apt-get install mesa-vulkan-drivers libvulkan1)"
+    )]
+    NoAdapter,
+    #[error("the GPU adapter {name} cannot run talus: {reason}")]
+    Unsuitable { name: String, reason: String },
+    #[error("could not open the GPU device {name}: {reason}")]
+    Open { name: String, reason: String },
+    #[error("the scene is too large for the GPU adapter {name}: {reason}")]
+    TooLarge { name: String, reason: String },
+}
+
+fn instance() -> wgpu::Instance {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::VULKAN;
+    wgpu::Instance::new(desc)
+}
+
+/// All adapters of the Vulkan backend.
+pub fn adapters() -> Vec<wgpu::Adapter> {
+    pollster::block_on(instance().enumerate_adapters(wgpu::Backends::VULKAN))
+}
+
+/// Why an adapter cannot be used, if it cannot.
+fn unsuitable(adapter: &wgpu::Adapter) -> Option<String> {
+    let l = adapter.limits();
+    if l.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS_NEEDED {
+        return Some(format!(
+            "it allows {} storage buffers per shader stage, talus needs {}",
+            l.max_storage_buffers_per_shader_stage, STORAGE_BUFFERS_NEEDED
+        ));
+    }
+    None
+}
+
+/// Preference order: a discrete GPU, then an integrated one, then anything else (a
+/// software rasteriser such as lavapipe last).
+fn rank(info: &wgpu::AdapterInfo) -> u32 {
+    match info.device_type {
+        wgpu::DeviceType::DiscreteGpu => 0,
+        wgpu::DeviceType::IntegratedGpu => 1,
+        wgpu::DeviceType::VirtualGpu => 2,
+        wgpu::DeviceType::Other => 3,
+        wgpu::DeviceType::Cpu => 4,
+    }
+}
+
+/// The adapter a GPU run would use: the best-ranked suitable one.
+pub fn choose_adapter() -> Result<wgpu::Adapter, DeviceError> {
+    let all = adapters();
+    if all.is_empty() {
+        return Err(DeviceError::NoAdapter);
+    }
+    let mut usable: Vec<_> = all.iter().filter(|a| unsuitable(a).is_none()).collect();
+    usable.sort_by_key(|a| rank(&a.get_info()));
+    match usable.first() {
+        Some(a) => Ok((*a).clone()),
+        None => {
+            let a = &all[0];
+            Err(DeviceError::Unsuitable {
+                name: a.get_info().name,
+                reason: unsuitable(a).unwrap_or_default(),
+            })
+        }
+    }
+}
+
+/// An open device with the limits talus asked for.
+pub struct Gpu {
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    pub info: wgpu::AdapterInfo,
+    pub limits: wgpu::Limits,
+}
+
+impl Gpu {
+    pub fn open() -> Result<Self, DeviceError> {
+        let adapter = choose_adapter()?;
+        let info = adapter.get_info();
+        let have = adapter.limits();
+        // Ask for the adapter's own buffer and dispatch limits: scenes of 10⁵–10⁶
+        // particles need more than WebGPU's defaults.
+        let limits = wgpu::Limits {
+            max_storage_buffers_per_shader_stage: STORAGE_BUFFERS_NEEDED,
+            max_storage_buffer_binding_size: have.max_storage_buffer_binding_size,
+            max_buffer_size: have.max_buffer_size,
+            max_compute_workgroups_per_dimension: have.max_compute_workgroups_per_dimension,
+            ..wgpu::Limits::downlevel_defaults()
+        };
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("talus"),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits.clone(),
+            experimental_features: wgpu::ExperimentalFeatures::disabled(),
+            memory_hints: wgpu::MemoryHints::Performance,
+            trace: wgpu::Trace::Off,
+        };
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&desc)).map_err(|e| DeviceError::Open {
+                name: info.name.clone(),
+                reason: e.to_string(),
+            })?;
+        Ok(Self {
+            device,
+            queue,
+            info,
+            limits,
+        })
+    }
+
+    /// Checks a buffer of `bytes` against the device limits before allocating it.
+    pub fn check_buffer(&self, what: &str, bytes: u64) -> Result<(), DeviceError> {
+        let max = self
+            .limits
+            .max_storage_buffer_binding_size
+            .min(self.limits.max_buffer_size);
+        if bytes > max {
+            return Err(DeviceError::TooLarge {
+                name: self.info.name.clone(),
+                reason: format!(
+                    "the {what} buffer needs {bytes} bytes and the adapter binds at most {max}"
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Whether tests must fail, rather than skip, when no adapter exists (CI sets it).
+pub fn gpu_required() -> bool {
+    std::env::var("TALUS_REQUIRE_GPU").is_ok_and(|v| v == "1")
+}
+
+/// The report printed by `talus info`.
+pub fn describe() -> String {
+    let mut s = String::new();
+    let all = adapters();
+    if all.is_empty() {
+        let _ = writeln!(s, "GPU adapters (Vulkan): none found");
+    } else {
+        let _ = writeln!(s, "GPU adapters (Vulkan):");
+    }
+    for a in &all {
+        let i = a.get_info();
+        let l = a.limits();
+        let _ = writeln!(s, "  - {} ({:?}, {:?})", i.name, i.backend, i.device_type);
+        let _ = writeln!(s, "      driver: {} {}", i.driver, i.driver_info);
+        let _ = writeln!(
+            s,
+            "      limits used: storage buffers per stage {}, storage binding {} MiB, \
+             buffer {} MiB, workgroups per dimension {}",
+            l.max_storage_buffers_per_shader_stage,
+            l.max_storage_buffer_binding_size >> 20,
+            l.max_buffer_size >> 20,
+            l.max_compute_workgroups_per_dimension
+        );
+        let _ = writeln!(
+            s,
+            "      features used: none beyond core WebGPU compute (f32, u32 atomics)"
+        );
+        if let Some(why) = unsuitable(a) {
+            let _ = writeln!(s, "      unsuitable: {why}");
+        }
+    }
+    let _ = match choose_adapter() {
+        Ok(a) => writeln!(
+            s,
+            "--backend auto or gpu would run on: {}",
+            a.get_info().name
+        ),
+        Err(e) => writeln!(
+            s,
+            "--backend auto would run on the CPU reference path ({e});\n--backend gpu would fail"
+        ),
+    };
+    s
+}

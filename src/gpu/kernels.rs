@@ -1,0 +1,221 @@
+//! The WGSL sources and their compute pipelines. Each stage file in `shaders/` is
+//! compiled after `common.wgsl` and the helper files it uses; every pipeline shares one
+//! pipeline layout (`common.wgsl`'s bindings), so a step binds its buffers once.
+
+/// A shader module: the stage file and the helper files it needs.
+pub struct ModuleSource {
+    pub name: &'static str,
+    pub parts: &'static [&'static str],
+}
+
+const COMMON: &str = include_str!("../../shaders/common.wgsl");
+const GEOMETRY: &str = include_str!("../../shaders/geometry.wgsl");
+const LAWS: &str = include_str!("../../shaders/laws.wgsl");
+
+pub const MODULES: &[ModuleSource] = &[
+    ModuleSource { name: "insert", parts: &[COMMON, include_str!("../../shaders/insert.wgsl")] },
+    ModuleSource { name: "predict", parts: &[COMMON, include_str!("../../shaders/predict.wgsl")] },
+    ModuleSource { name: "cell_index", parts: &[COMMON, include_str!("../../shaders/cell_index.wgsl")] },
+    ModuleSource {
+        name: "cell_histogram",
+        parts: &[COMMON, include_str!("../../shaders/cell_histogram.wgsl")],
+    },
+    ModuleSource { name: "prefix_sum", parts: &[COMMON, include_str!("../../shaders/prefix_sum.wgsl")] },
+    ModuleSource { name: "scatter", parts: &[COMMON, include_str!("../../shaders/scatter.wgsl")] },
+    ModuleSource {
+        name: "find_contacts",
+        parts: &[COMMON, GEOMETRY, include_str!("../../shaders/find_contacts.wgsl")],
+    },
+    ModuleSource {
+        name: "gather_history",
+        parts: &[COMMON, include_str!("../../shaders/gather_history.wgsl")],
+    },
+    ModuleSource {
+        name: "contact_forces",
+        parts: &[COMMON, GEOMETRY, LAWS, include_str!("../../shaders/contact_forces.wgsl")],
+    },
+    ModuleSource {
+        name: "store_history",
+        parts: &[COMMON, include_str!("../../shaders/store_history.wgsl")],
+    },
+    ModuleSource {
+        name: "reduce_forces",
+        parts: &[COMMON, include_str!("../../shaders/reduce_forces.wgsl")],
+    },
+    ModuleSource { name: "correct", parts: &[COMMON, include_str!("../../shaders/correct.wgsl")] },
+    ModuleSource { name: "kick_drift", parts: &[COMMON, include_str!("../../shaders/kick_drift.wgsl")] },
+    ModuleSource { name: "boundaries", parts: &[COMMON, include_str!("../../shaders/boundaries.wgsl")] },
+];
+
+impl ModuleSource {
+    pub fn source(&self) -> String {
+        self.parts.join("\n")
+    }
+}
+
+/// Every entry point: (module, entry point). The order is the order of a step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Kernel {
+    InsertCheck,
+    InsertPlace,
+    Predict,
+    ClearCells,
+    CellIndex,
+    CellHistogram,
+    ScanLevel0,
+    ScanLevel1,
+    ScanLevel2,
+    ScanAdd1,
+    ScanAdd0,
+    ClearCursor,
+    Scatter,
+    FindContacts,
+    GatherHistory,
+    ContactForces,
+    ClearTable,
+    StoreHistory,
+    ReduceForces,
+    Correct,
+    KickDrift,
+    Boundaries,
+    AdvanceClock,
+}
+
+impl Kernel {
+    pub const ALL: [Kernel; 23] = [
+        Kernel::InsertCheck,
+        Kernel::InsertPlace,
+        Kernel::Predict,
+        Kernel::ClearCells,
+        Kernel::CellIndex,
+        Kernel::CellHistogram,
+        Kernel::ScanLevel0,
+        Kernel::ScanLevel1,
+        Kernel::ScanLevel2,
+        Kernel::ScanAdd1,
+        Kernel::ScanAdd0,
+        Kernel::ClearCursor,
+        Kernel::Scatter,
+        Kernel::FindContacts,
+        Kernel::GatherHistory,
+        Kernel::ContactForces,
+        Kernel::ClearTable,
+        Kernel::StoreHistory,
+        Kernel::ReduceForces,
+        Kernel::Correct,
+        Kernel::KickDrift,
+        Kernel::Boundaries,
+        Kernel::AdvanceClock,
+    ];
+
+    /// (module name, entry point name).
+    pub fn entry(self) -> (&'static str, &'static str) {
+        match self {
+            Kernel::InsertCheck => ("insert", "insert_check"),
+            Kernel::InsertPlace => ("insert", "insert_place"),
+            Kernel::Predict => ("predict", "predict"),
+            Kernel::ClearCells => ("cell_index", "clear_cells"),
+            Kernel::CellIndex => ("cell_index", "cell_index"),
+            Kernel::CellHistogram => ("cell_histogram", "cell_histogram"),
+            Kernel::ScanLevel0 => ("prefix_sum", "scan_level0"),
+            Kernel::ScanLevel1 => ("prefix_sum", "scan_level1"),
+            Kernel::ScanLevel2 => ("prefix_sum", "scan_level2"),
+            Kernel::ScanAdd1 => ("prefix_sum", "scan_add1"),
+            Kernel::ScanAdd0 => ("prefix_sum", "scan_add0"),
+            Kernel::ClearCursor => ("scatter", "clear_cursor"),
+            Kernel::Scatter => ("scatter", "scatter"),
+            Kernel::FindContacts => ("find_contacts", "find_contacts"),
+            Kernel::GatherHistory => ("gather_history", "gather_history"),
+            Kernel::ContactForces => ("contact_forces", "contact_forces"),
+            Kernel::ClearTable => ("store_history", "clear_table"),
+            Kernel::StoreHistory => ("store_history", "store_history"),
+            Kernel::ReduceForces => ("reduce_forces", "reduce_forces"),
+            Kernel::Correct => ("correct", "correct"),
+            Kernel::KickDrift => ("kick_drift", "kick_drift"),
+            Kernel::Boundaries => ("boundaries", "boundaries"),
+            Kernel::AdvanceClock => ("boundaries", "advance_clock"),
+        }
+    }
+}
+
+/// Storage bindings of group 0 (binding 0 is the uniform Params) and of group 1.
+pub const GROUP0_STORAGE: u32 = 19;
+pub const GROUP1_STORAGE: u32 = 2;
+
+fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: false },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+pub struct Pipelines {
+    pub group0: wgpu::BindGroupLayout,
+    pub group1: wgpu::BindGroupLayout,
+    pub pipelines: std::collections::HashMap<Kernel, wgpu::ComputePipeline>,
+}
+
+impl Pipelines {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let mut entries = vec![wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        }];
+        entries.extend((1..=GROUP0_STORAGE).map(storage_entry));
+        let group0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("talus group 0"),
+            entries: &entries,
+        });
+        let group1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("talus springs"),
+            entries: &(0..GROUP1_STORAGE).map(storage_entry).collect::<Vec<_>>(),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("talus"),
+            bind_group_layouts: &[Some(&group0), Some(&group1)],
+            immediate_size: 0,
+        });
+        let modules: std::collections::HashMap<&str, wgpu::ShaderModule> = MODULES
+            .iter()
+            .map(|m| {
+                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                    label: Some(m.name),
+                    source: wgpu::ShaderSource::Wgsl(m.source().into()),
+                });
+                (m.name, module)
+            })
+            .collect();
+        let pipelines = Kernel::ALL
+            .iter()
+            .map(|&k| {
+                let (module, entry) = k.entry();
+                let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some(entry),
+                    layout: Some(&layout),
+                    module: &modules[module],
+                    entry_point: Some(entry),
+                    compilation_options: Default::default(),
+                    cache: None,
+                });
+                (k, p)
+            })
+            .collect();
+        Self {
+            group0,
+            group1,
+            pipelines,
+        }
+    }
+}

@@ -1,0 +1,187 @@
+//! The data layouts shared with the kernels: `#[repr(C)]` twins of the structs in
+//! `shaders/common.wgsl`. `tests/gpu_layout.rs` checks each size and field offset
+//! against naga's layout of the WGSL, so the two cannot drift apart.
+
+use bytemuck::{Pod, Zeroable};
+
+/// Contacts per particle as the lower id, and as the higher id (`MAX_CONTACTS`).
+pub const MAX_CONTACTS: u32 = 16;
+/// Candidates of one source looked at per step (`INSERT_WINDOW`); the CPU path uses the
+/// same cap so that both insert on the same steps.
+pub const INSERT_WINDOW: u32 = 4;
+pub const EMPTY: u32 = u32::MAX;
+pub const ACTIVE: u32 = 1;
+pub const FIXED: u32 = 2;
+/// Workgroup size of the per-particle kernels (`WG`).
+pub const WG: u32 = 64;
+/// Workgroup size of the prefix sum (`SCAN_WG`).
+pub const SCAN_WG: u32 = 256;
+
+/// Words of the control buffer (`C_*` in common.wgsl).
+pub mod control {
+    pub const STEP: usize = 0;
+    pub const LIVE: usize = 1;
+    pub const LOST: usize = 2;
+    pub const HALT: usize = 3;
+    pub const HALT_STEP: usize = 4;
+    pub const HALT_ID: usize = 5;
+    pub const BLOCKED: usize = 8;
+    pub const HALT_OVERLAP: u32 = 1;
+    pub const HALT_NOT_FINITE: u32 = 2;
+    pub const HALT_CONTACTS_FULL: u32 = 4;
+    pub const HALT_TABLE_FULL: u32 = 8;
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Params {
+    pub n_cap: u32,
+    pub nx: u32,
+    pub nz: u32,
+    pub cells: u32,
+    pub n_walls: u32,
+    pub n_sources: u32,
+    pub table_mask: u32,
+    pub integrator: u32,
+    pub cell_size: f32,
+    pub dt: f32,
+    pub max_overlap: f32,
+    pub range_factor: f32,
+    pub gx: f32,
+    pub gz: f32,
+    pub ramp_steps: f32,
+    pub law: u32,
+    pub dom_lo_x: f32,
+    pub dom_lo_z: f32,
+    pub dom_hi_x: f32,
+    pub dom_hi_z: f32,
+    pub k_n: f32,
+    pub nu: f32,
+    pub psi: f32,
+    pub delta0: f32,
+    pub gamma_n: f32,
+    pub k_t: f32,
+    pub gamma_t: f32,
+    pub mu: f32,
+    pub clamp: u32,
+    pub elastic: u32,
+    pub n_exp: f32,
+    pub hooke_k: f32,
+    pub r0: f32,
+    pub alpha: f32,
+    pub damping_fraction: f32,
+    pub g_scale: f32,
+    pub scan_blocks1: u32,
+    pub scan_blocks2: u32,
+    pub scan_offset2: u32,
+    pub _pad: u32,
+}
+
+/// Dynamic state of one particle: q[0] = (frac_x, frac_z, θ, 0) and the scaled Gear
+/// derivatives q[1..6]; the position is `anchor · cell_size + frac` from the grid origin.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct State {
+    pub q: [[f32; 4]; 6],
+    pub anchor: [i32; 2],
+    pub _pad: [u32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Props {
+    pub radius: f32,
+    pub mass: f32,
+    pub inv_inertia: f32,
+    pub flags: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct ContactOut {
+    /// (f_x, f_z) on i, torque on i, torque on j.
+    pub ft: [f32; 4],
+    /// f_n, f_t, overlap, elastic energy.
+    pub info: [f32; 4],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Wall {
+    pub anchor: [i32; 2],
+    pub frac: [f32; 2],
+    pub ab: [f32; 2],
+    pub _pad: [f32; 2],
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Entry {
+    pub i: u32,
+    pub j: u32,
+    pub value: f32,
+    pub _pad: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Source {
+    pub first: u32,
+    pub count: u32,
+    pub inserted: u32,
+    pub _pad: u32,
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct Candidate {
+    pub anchor: [i32; 2],
+    pub frac: [f32; 2],
+    pub velocity: [f32; 2],
+    pub radius: f32,
+    pub mass: f32,
+    pub inv_inertia: f32,
+    pub due_step: u32,
+    pub flags: u32,
+    pub _pad: u32,
+}
+
+/// Field offsets of each struct, by WGSL member name, for the layout test.
+pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
+    use std::mem::{offset_of, size_of};
+    macro_rules! fields {
+        ($t:ty, $name:literal, [$($f:ident),*]) => {
+            ($name, size_of::<$t>(), vec![$((stringify!($f), offset_of!($t, $f))),*])
+        };
+    }
+    vec![
+        fields!(Params, "Params", [
+            n_cap, nx, nz, cells, n_walls, n_sources, table_mask, integrator, cell_size,
+            dt, max_overlap, range_factor, gx, gz, ramp_steps, law, dom_lo_x, dom_lo_z,
+            dom_hi_x, dom_hi_z, k_n, nu, psi, delta0, gamma_n, k_t, gamma_t, mu, clamp,
+            elastic, n_exp, hooke_k, r0, alpha, damping_fraction, g_scale, scan_blocks1,
+            scan_blocks2, scan_offset2, _pad
+        ]),
+        fields!(State, "State", [q, anchor, _pad]),
+        fields!(Props, "Props", [radius, mass, inv_inertia, flags]),
+        fields!(ContactOut, "ContactOut", [ft, info]),
+        fields!(Wall, "Wall", [anchor, frac, ab, _pad]),
+        fields!(Entry, "Entry", [i, j, value, _pad]),
+        fields!(Source, "Source", [first, count, inserted, _pad]),
+        fields!(Candidate, "Candidate", [
+            anchor, frac, velocity, radius, mass, inv_inertia, due_step, flags, _pad
+        ]),
+    ]
+}
+
+/// The spring table's slot hash, twin of `hash_pair` in common.wgsl (used on the host
+/// to rebuild a table from a checkpoint).
+pub fn hash_pair(i: u32, j: u32) -> u32 {
+    let mut h = i.wrapping_mul(0x9E37_79B1) ^ j.wrapping_add(0x7F4A_7C15).wrapping_mul(0x85EB_CA77);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7FEB_352D);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846C_A68B);
+    h ^= h >> 16;
+    h
+}

@@ -1,0 +1,925 @@
+//! The GPU path: the whole disk time step as WGSL compute kernels on wgpu (issue 3).
+//!
+//! Particle state lives in storage buffers for the whole run. The host encodes many
+//! steps into one submission (every stage of every step is one dispatch, see
+//! [`GpuSimulation::encode_step`]) and reads back only a few control words after each
+//! submission (step, live count, lost count, halt flags), plus the full state when an
+//! output needs it ([`GpuSimulation::download`]).
+//!
+//! The host keeps a CPU [`Simulation`] as a mirror: it holds the scene, the law and the
+//! grid, and after `download` the state in f64, so snapshots, checkpoints, energies and
+//! the settling rule are the CPU path's own code.
+
+pub mod device;
+pub mod kernels;
+pub mod layout;
+
+use crate::contacts::{Pair, WALL_BASE};
+use crate::create::source::{self, SourceState};
+use crate::forces::ContactForce;
+use crate::geometry::{disk_disk, disk_wall};
+use crate::law::ContactLaw;
+use crate::scene::{Creation, IntegratorKind, PointSource};
+use crate::sim::{Divergence, Simulation};
+use crate::springs::{SpringTable, pair_key};
+use crate::state::{GEAR_VALUES, NewDisk, Particles};
+use device::{DeviceError, Gpu};
+use kernels::{Kernel, Pipelines};
+use layout::*;
+use wgpu::util::DeviceExt;
+
+/// Steps encoded into one submission at most. Between submissions the host reads the
+/// control words (divergence check, progress).
+pub const STEPS_PER_SUBMIT: u64 = 64;
+
+/// Cells of the grid at most: one dispatch of `clear_cells` covers 65535 workgroups.
+pub const MAX_CELLS: u64 = 65535 * WG as u64;
+
+struct Buffers {
+    params: wgpu::Buffer,
+    state: wgpu::Buffer,
+    props: wgpu::Buffer,
+    cell_of: wgpu::Buffer,
+    cell_count: wgpu::Buffer,
+    cell_start: wgpu::Buffer,
+    scan: wgpu::Buffer,
+    sorted: wgpu::Buffer,
+    contact_j: wgpu::Buffer,
+    contact_count: wgpu::Buffer,
+    down: wgpu::Buffer,
+    down_count: wgpu::Buffer,
+    hist_in: wgpu::Buffer,
+    hist_out: wgpu::Buffer,
+    contact_out: wgpu::Buffer,
+    force: wgpu::Buffer,
+    walls: wgpu::Buffer,
+    control: wgpu::Buffer,
+    sources: wgpu::Buffer,
+    candidates: wgpu::Buffer,
+    tables: [wgpu::Buffer; 2],
+}
+
+/// The source bookkeeping of the host: where each source stood at upload.
+struct SourceBase {
+    spec: PointSource,
+    state: SourceState,
+}
+
+pub struct GpuSimulation {
+    /// The host mirror; its state is current after [`GpuSimulation::download`].
+    pub sim: Simulation,
+    gpu: Gpu,
+    pipelines: Pipelines,
+    buffers: Buffers,
+    group0: wgpu::BindGroup,
+    /// group1[p]: table p is "old" (read), the other is "new" (written).
+    group1: [wgpu::BindGroup; 2],
+    /// Which table holds the springs of the last completed step.
+    parity: usize,
+    pub params: Params,
+    n_cap: u32,
+    origin: [f64; 2],
+    sources: Vec<SourceBase>,
+    /// Particles and loss count at upload (the GPU counts from there).
+    lost_base: u64,
+    /// The step the device is at (known on the host without a readback).
+    step: u64,
+    live: u32,
+    synced: bool,
+}
+
+/// What a GPU checkpoint adds to the f64 state: the exact device state, so that a GPU
+/// run resumes bitwise (f32 → f64 → f32 would round-trip, but the anchor split would not).
+#[derive(Clone, Debug, PartialEq)]
+pub struct DeviceState {
+    pub states: Vec<State>,
+    pub props: Vec<Props>,
+    pub springs: Vec<Entry>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    #[error(transparent)]
+    Device(#[from] DeviceError),
+    #[error("GPU readback failed: {0}")]
+    Readback(String),
+}
+
+fn ceil_div(a: u64, b: u64) -> u64 {
+    a.div_ceil(b)
+}
+
+impl GpuSimulation {
+    /// Opens the best adapter and uploads the simulation's state.
+    pub fn new(sim: Simulation) -> Result<Self, GpuError> {
+        Self::with_gpu(sim, Gpu::open()?)
+    }
+
+    pub fn with_gpu(mut sim: Simulation, gpu: Gpu) -> Result<Self, GpuError> {
+        let device_state = sim.device_state.take();
+        let grid = sim.grid.clone();
+        let cells = grid.cell_count() as u64;
+        if cells > MAX_CELLS {
+            return Err(DeviceError::TooLarge {
+                name: gpu.info.name.clone(),
+                reason: format!(
+                    "the cell grid has {cells} cells ({} × {}), the GPU path handles at most \
+                     {MAX_CELLS}; make the domain smaller",
+                    grid.nx, grid.nz
+                ),
+            }
+            .into());
+        }
+        // The anchor unit is the cell size, rounded to f32 (up, so cells stay ≥ range).
+        let mut cell_size = grid.cell_size as f32;
+        if (cell_size as f64) < grid.cell_size {
+            cell_size = f32::from_bits(cell_size.to_bits() + 1);
+        }
+        let origin = grid.origin;
+
+        // Sources: every candidate still to come, drawn now.
+        let specs: Vec<PointSource> = sim
+            .scene
+            .particles
+            .iter()
+            .filter_map(|c| match c {
+                Creation::PointSource(s) => Some(s.clone()),
+                _ => None,
+            })
+            .collect();
+        let mut sources = Vec::new();
+        let mut source_rows = Vec::new();
+        let mut candidates = Vec::new();
+        let dt = sim.dt();
+        for (spec, st) in specs.iter().zip(&sim.sources) {
+            let list = source::upcoming(spec, st);
+            source_rows.push(Source {
+                first: candidates.len() as u32,
+                count: list.len() as u32,
+                inserted: 0,
+                _pad: 0,
+            });
+            let material = crate::create::material_index(&sim.scene, &spec.material);
+            for (k, [x, d]) in list.into_iter().enumerate() {
+                let disk = NewDisk {
+                    position: [x, spec.position[1]],
+                    theta: 0.0,
+                    velocity: spec.velocity,
+                    omega: 0.0,
+                    radius: 0.5 * d,
+                    fixed: false,
+                    fixed_rotation: false,
+                    material,
+                };
+                let mut one = Particles::default();
+                crate::create::push(&sim.scene, &mut one, &disk);
+                let (anchor, frac) = split(x - origin[0], spec.position[1] - origin[1], cell_size);
+                let due = source::due_step(source::due_time(spec, st.inserted + k as u32), dt);
+                candidates.push(Candidate {
+                    anchor,
+                    frac,
+                    velocity: [(spec.velocity[0] * dt) as f32, (spec.velocity[1] * dt) as f32],
+                    radius: one.radius[0] as f32,
+                    mass: one.mass[0] as f32,
+                    inv_inertia: (1.0 / one.inertia[0]) as f32,
+                    due_step: due.min(u32::MAX as u64) as u32,
+                    flags: ACTIVE | (material << 8),
+                    _pad: 0,
+                });
+            }
+            sources.push(SourceBase {
+                spec: spec.clone(),
+                state: st.clone(),
+            });
+        }
+        let n_now = sim.particles.len() as u32;
+        let n_cap = (n_now + candidates.len() as u32).max(1);
+        let table_cap = (8 * n_cap as u64).next_power_of_two().max(64);
+
+        let law = &sim.law;
+        let g = sim.scene.gravity.g;
+        let ramp = sim.scene.gravity.ramp_time;
+        let d = &sim.scene.domain;
+        let blocks1 = ceil_div(cells, SCAN_WG as u64) as u32;
+        let blocks2 = ceil_div(blocks1 as u64, SCAN_WG as u64) as u32;
+        let mut params = Params {
+            n_cap,
+            nx: grid.nx,
+            nz: grid.nz,
+            cells: cells as u32,
+            n_walls: sim.walls.len() as u32,
+            n_sources: sources.len() as u32,
+            table_mask: (table_cap - 1) as u32,
+            integrator: match sim.scene.integrator {
+                IntegratorKind::Gear5 => 0,
+                IntegratorKind::Leapfrog => 1,
+            },
+            cell_size,
+            dt: dt as f32,
+            max_overlap: sim.scene.limits.max_overlap as f32,
+            range_factor: law.range_factor() as f32,
+            gx: g[0] as f32,
+            gz: g[1] as f32,
+            ramp_steps: if ramp > 0.0 { (ramp / dt) as f32 } else { 0.0 },
+            law: 0,
+            dom_lo_x: (d.x[0] - origin[0]) as f32,
+            dom_lo_z: (d.z[0] - origin[1]) as f32,
+            dom_hi_x: (d.x[1] - origin[0]) as f32,
+            dom_hi_z: (d.z[1] - origin[1]) as f32,
+            scan_blocks1: blocks1,
+            scan_blocks2: blocks2,
+            scan_offset2: blocks1.next_multiple_of(SCAN_WG),
+            ..Default::default()
+        };
+        law_params(law, &mut params);
+
+        let check = |what: &str, bytes: u64| gpu.check_buffer(what, bytes);
+        let n = n_cap as u64;
+        let m = MAX_CONTACTS as u64;
+        check("particle state", n * size_of::<State>() as u64)?;
+        check("contact", n * m * size_of::<ContactOut>() as u64)?;
+        check("spring table", table_cap * size_of::<Entry>() as u64)?;
+        check("cell", cells * 4)?;
+
+        let dev = &gpu.device;
+        let storage = wgpu::BufferUsages::STORAGE
+            | wgpu::BufferUsages::COPY_DST
+            | wgpu::BufferUsages::COPY_SRC;
+        let zeroed = |label: &str, bytes: u64| {
+            dev.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes.max(64).next_multiple_of(16),
+                usage: storage,
+                mapped_at_creation: false,
+            })
+        };
+        let init = |label: &str, bytes: &[u8]| {
+            let mut v = bytes.to_vec();
+            v.resize(v.len().max(64).next_multiple_of(16), 0);
+            dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &v,
+                usage: storage,
+            })
+        };
+
+        let walls: Vec<Wall> = sim
+            .walls
+            .iter()
+            .map(|w| {
+                let (anchor, frac) = split(w.a[0] - origin[0], w.a[1] - origin[1], cell_size);
+                Wall {
+                    anchor,
+                    frac,
+                    ab: [(w.b[0] - w.a[0]) as f32, (w.b[1] - w.a[1]) as f32],
+                    _pad: [0.0; 2],
+                }
+            })
+            .collect();
+
+        let mut control = vec![0u32; control::BLOCKED + (sources.len() * INSERT_WINDOW as usize).max(1)];
+        control[control::STEP] = sim.step as u32;
+        control[control::LIVE] = n_now;
+        control[control::HALT_STEP] = u32::MAX;
+        control[control::HALT_ID] = u32::MAX;
+
+        let (states, props, entries) = match device_state {
+            Some(ds) => (ds.states, ds.props, ds.springs),
+            None => {
+                let (s, p) = to_device(&sim.particles, origin, cell_size);
+                let e = sim
+                    .springs
+                    .entries()
+                    .map(|(k, v)| Entry {
+                        i: (k >> 32) as u32,
+                        j: k as u32,
+                        value: v as f32,
+                        _pad: 0,
+                    })
+                    .collect();
+                (s, p, e)
+            }
+        };
+        let mut state_all = vec![State::default(); n_cap as usize];
+        state_all[..states.len()].copy_from_slice(&states);
+        let mut props_all = vec![Props::default(); n_cap as usize];
+        props_all[..props.len()].copy_from_slice(&props);
+        let table = build_table(&entries, table_cap as usize);
+
+        let buffers = Buffers {
+            params: dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("params"),
+                contents: bytemuck::bytes_of(&params),
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            }),
+            state: init("state", bytemuck::cast_slice(&state_all)),
+            props: init("props", bytemuck::cast_slice(&props_all)),
+            cell_of: zeroed("cell_of", n * 4),
+            cell_count: zeroed("cell_count", cells * 4),
+            cell_start: zeroed("cell_start", cells * 4),
+            scan: zeroed("scan", (params.scan_offset2 as u64 + SCAN_WG as u64) * 4),
+            sorted: zeroed("sorted", n * 4),
+            contact_j: zeroed("contact_j", n * m * 4),
+            contact_count: zeroed("contact_count", n * 4),
+            down: zeroed("down", n * m * 4),
+            down_count: zeroed("down_count", n * 4),
+            hist_in: zeroed("hist_in", n * m * 4),
+            hist_out: zeroed("hist_out", n * m * 4),
+            contact_out: zeroed("contact_out", n * m * size_of::<ContactOut>() as u64),
+            force: zeroed("force", n * 16),
+            walls: init("walls", bytemuck::cast_slice(&walls)),
+            control: init("control", bytemuck::cast_slice(&control)),
+            sources: init("sources", bytemuck::cast_slice(&source_rows)),
+            candidates: init("candidates", bytemuck::cast_slice(&candidates)),
+            tables: [
+                init("springs 0", bytemuck::cast_slice(&table)),
+                init("springs 1", bytemuck::cast_slice(&table)),
+            ],
+        };
+        let pipelines = Pipelines::new(dev);
+        let b = &buffers;
+        let group0_buffers = [
+            &b.params,
+            &b.state,
+            &b.props,
+            &b.cell_of,
+            &b.cell_count,
+            &b.cell_start,
+            &b.scan,
+            &b.sorted,
+            &b.contact_j,
+            &b.contact_count,
+            &b.down,
+            &b.down_count,
+            &b.hist_in,
+            &b.hist_out,
+            &b.contact_out,
+            &b.force,
+            &b.walls,
+            &b.control,
+            &b.sources,
+            &b.candidates,
+        ];
+        let entries0: Vec<_> = group0_buffers
+            .iter()
+            .enumerate()
+            .map(|(k, buf)| wgpu::BindGroupEntry {
+                binding: k as u32,
+                resource: buf.as_entire_binding(),
+            })
+            .collect();
+        let group0 = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("talus group 0"),
+            layout: &pipelines.group0,
+            entries: &entries0,
+        });
+        let pair_group = |old: usize| {
+            dev.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("springs"),
+                layout: &pipelines.group1,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: b.tables[old].as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: b.tables[1 - old].as_entire_binding(),
+                    },
+                ],
+            })
+        };
+        let group1 = [pair_group(0), pair_group(1)];
+        let lost_base = sim.lost;
+        let step = sim.step;
+        Ok(Self {
+            sim,
+            gpu,
+            pipelines,
+            buffers,
+            group0,
+            group1,
+            parity: 0,
+            params,
+            n_cap,
+            origin,
+            sources,
+            lost_base,
+            step,
+            live: n_now,
+            synced: true,
+        })
+    }
+
+    pub fn adapter_name(&self) -> &str {
+        &self.gpu.info.name
+    }
+
+    /// The step the device has reached.
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+
+    /// Particles created so far (active or lost).
+    pub fn live(&self) -> u32 {
+        self.live
+    }
+
+    fn dispatch(&self, pass: &mut wgpu::ComputePass, k: Kernel, groups: u64) {
+        pass.set_pipeline(&self.pipelines.pipelines[&k]);
+        pass.dispatch_workgroups(groups.max(1) as u32, 1, 1);
+    }
+
+    fn per_particle(&self) -> u64 {
+        ceil_div(self.n_cap as u64, WG as u64)
+    }
+
+    /// Records the dispatches of one kernel (for tests of single stages).
+    pub fn encode_kernel(&self, pass: &mut wgpu::ComputePass, k: Kernel) {
+        let p = &self.params;
+        let groups = match k {
+            Kernel::InsertPlace | Kernel::ScanLevel2 | Kernel::AdvanceClock => 1,
+            Kernel::ClearCells => ceil_div(p.cells.max(p.n_cap) as u64, WG as u64),
+            Kernel::ClearCursor => ceil_div(p.cells as u64, WG as u64),
+            Kernel::ScanLevel0 | Kernel::ScanAdd0 => p.scan_blocks1 as u64,
+            Kernel::ScanLevel1 | Kernel::ScanAdd1 => p.scan_blocks2 as u64,
+            Kernel::ClearTable => ceil_div(p.table_mask as u64 + 1, WG as u64),
+            _ => self.per_particle(),
+        };
+        self.dispatch(pass, k, groups);
+    }
+
+    /// Runs some kernels once, in order, in one submission (tests of single stages).
+    pub fn run_kernels(&mut self, ks: &[Kernel]) {
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &self.group0, &[]);
+            pass.set_bind_group(1, &self.group1[self.parity], &[]);
+            for &k in ks {
+                self.encode_kernel(&mut pass, k);
+            }
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.synced = false;
+    }
+
+    /// The kernels of the cell list, in order.
+    pub const CELL_LIST: [Kernel; 10] = [
+        Kernel::ClearCells,
+        Kernel::CellIndex,
+        Kernel::CellHistogram,
+        Kernel::ScanLevel0,
+        Kernel::ScanLevel1,
+        Kernel::ScanLevel2,
+        Kernel::ScanAdd1,
+        Kernel::ScanAdd0,
+        Kernel::ClearCursor,
+        Kernel::Scatter,
+    ];
+
+    /// One time step, stage by stage as in `Simulation::step`.
+    fn encode_step(&self, pass: &mut wgpu::ComputePass, parity: usize, sources_left: bool) {
+        pass.set_bind_group(1, &self.group1[parity], &[]);
+        if sources_left {
+            self.encode_kernel(pass, Kernel::InsertCheck);
+            self.encode_kernel(pass, Kernel::InsertPlace);
+        }
+        let gear = self.params.integrator == 0;
+        if gear {
+            self.encode_kernel(pass, Kernel::Predict);
+        }
+        for k in Self::CELL_LIST {
+            self.encode_kernel(pass, k);
+        }
+        for k in [
+            Kernel::FindContacts,
+            Kernel::GatherHistory,
+            Kernel::ContactForces,
+            Kernel::ClearTable,
+            Kernel::StoreHistory,
+            Kernel::ReduceForces,
+        ] {
+            self.encode_kernel(pass, k);
+        }
+        self.encode_kernel(pass, if gear { Kernel::Correct } else { Kernel::KickDrift });
+        self.encode_kernel(pass, Kernel::Boundaries);
+        self.encode_kernel(pass, Kernel::AdvanceClock);
+    }
+
+    /// Whether candidates are still waiting: every particle created on the device comes
+    /// from a source, and the buffers were sized for all of them.
+    fn sources_left(&self) -> bool {
+        self.live < self.n_cap && !self.sources.is_empty()
+    }
+
+    /// Advances `steps` steps, `STEPS_PER_SUBMIT` per submission; after each submission
+    /// the control words are read to catch a divergence.
+    pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
+        let mut left = steps;
+        let sources_left = self.sources_left();
+        while left > 0 {
+            let k = left.min(STEPS_PER_SUBMIT);
+            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+            {
+                let mut pass = enc.begin_compute_pass(&Default::default());
+                pass.set_bind_group(0, &self.group0, &[]);
+                for s in 0..k {
+                    let parity = (self.parity + s as usize) % 2;
+                    self.encode_step(&mut pass, parity, sources_left);
+                }
+            }
+            self.gpu.queue.submit([enc.finish()]);
+            self.synced = false;
+            let c = self.read_control();
+            self.live = c[control::LIVE];
+            if c[control::HALT] != 0 {
+                return Err(self.halt_cause(&c));
+            }
+            self.parity = (self.parity + k as usize) % 2;
+            self.step += k;
+            left -= k;
+        }
+        Ok(())
+    }
+
+    fn halt_cause(&mut self, c: &[u32]) -> Divergence {
+        // The device stopped inside the last submission, at the start of step
+        // `halt_step`; the steps before it completed (and flipped the tables).
+        let halt_step = c[control::HALT_STEP] as u64;
+        self.parity = (self.parity + (halt_step - self.step) as usize) % 2;
+        self.step = halt_step;
+        let id = c[control::HALT_ID];
+        let flags = c[control::HALT];
+        self.download();
+        self.sim.step = halt_step;
+        if flags & control::HALT_OVERLAP != 0 {
+            let limit = self.sim.scene.limits.max_overlap;
+            let mut worst: Option<(u32, f64)> = None;
+            for (p, cf) in self.sim.pairs.iter().zip(&self.sim.contacts) {
+                if p.i != id {
+                    continue;
+                }
+                let ri = self.sim.particles.radius[p.i as usize];
+                let rmin = if p.is_wall() { ri } else { ri.min(self.sim.particles.radius[p.j as usize]) };
+                let ratio = cf.overlap / rmin;
+                if worst.is_none_or(|(_, r)| ratio > r) {
+                    worst = Some((p.j, ratio));
+                }
+            }
+            let (j, ratio) = worst.unwrap_or((u32::MAX, f64::NAN));
+            let j = if j >= WALL_BASE && j != u32::MAX {
+                format!("wall {}", j - WALL_BASE)
+            } else {
+                j.to_string()
+            };
+            return Divergence::Overlap { i: id, j, ratio, limit };
+        }
+        if flags & control::HALT_NOT_FINITE != 0 {
+            return Divergence::NotFinite { id, what: "force or position" };
+        }
+        if flags & control::HALT_CONTACTS_FULL != 0 {
+            return Divergence::TooManyContacts { id, max: MAX_CONTACTS };
+        }
+        Divergence::SpringTableFull { id }
+    }
+
+    fn read_control(&self) -> Vec<u32> {
+        let words = control::BLOCKED;
+        self.read_buffer::<u32>(&self.buffers.control, 0, words)
+    }
+
+    /// Copies `count` elements of type T from a buffer (blocking).
+    fn read_buffer<T: bytemuck::Pod>(&self, buf: &wgpu::Buffer, first: usize, count: usize) -> Vec<T> {
+        let size = size_of::<T>() as u64;
+        let bytes = (count as u64 * size).next_multiple_of(4);
+        if bytes == 0 {
+            return Vec::new();
+        }
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(buf, first as u64 * size, &staging, 0, bytes);
+        self.gpu.queue.submit([enc.finish()]);
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| r.expect("GPU readback failed"));
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("GPU device lost");
+        let view = slice.get_mapped_range().expect("mapped");
+        let out = bytemuck::cast_slice::<u8, T>(&view[..count * size as usize]).to_vec();
+        drop(view);
+        staging.unmap();
+        out
+    }
+
+    fn write_buffer<T: bytemuck::Pod>(&mut self, buf: &wgpu::Buffer, data: &[T]) {
+        self.gpu.queue.write_buffer(buf, 0, bytemuck::cast_slice(data));
+        self.synced = false;
+    }
+
+    /// Reads the device state into the host mirror `self.sim` (f64 particles, this step's
+    /// contacts and forces, the spring table, source progress, step and losses).
+    pub fn download(&mut self) -> &Simulation {
+        if self.synced {
+            return &self.sim;
+        }
+        let c = self.read_control();
+        let live = c[control::LIVE] as usize;
+        self.live = live as u32;
+        let ds = self.device_state();
+        let cell = self.params.cell_size;
+        let p = from_device(&ds.states, &ds.props, self.origin, cell);
+        self.sim.particles = p;
+        self.sim.step = self.step;
+        self.sim.lost = self.lost_base + c[control::LOST] as u64;
+        let mut table = SpringTable::with_capacity_for(ds.springs.len());
+        for e in &ds.springs {
+            table.insert(pair_key(Pair { i: e.i, j: e.j }), e.value as f64);
+        }
+        self.sim.springs = table;
+        let rows: Vec<Source> = self.read_buffer(&self.buffers.sources, 0, self.sources.len());
+        self.sim.sources = self
+            .sources
+            .iter()
+            .zip(&rows)
+            .map(|(b, r)| source::advanced(&b.spec, &b.state, r.inserted))
+            .collect();
+        // This step's contacts, in the CPU's order (by i, then j; walls last).
+        let m = MAX_CONTACTS as usize;
+        let count: Vec<u32> = self.read_buffer(&self.buffers.contact_count, 0, live);
+        let js: Vec<u32> = self.read_buffer(&self.buffers.contact_j, 0, live * m);
+        let outs: Vec<ContactOut> = self.read_buffer(&self.buffers.contact_out, 0, live * m);
+        let mut pairs = Vec::new();
+        let mut contacts = Vec::new();
+        let parts = &self.sim.particles;
+        for i in 0..live {
+            for k in 0..count[i] as usize {
+                let j = js[i * m + k];
+                let o = outs[i * m + k];
+                let pi = parts.position(i);
+                let g = if j >= WALL_BASE {
+                    disk_wall(pi, parts.radius[i], &self.sim.walls[(j - WALL_BASE) as usize])
+                } else {
+                    disk_disk(pi, parts.radius[i], parts.position(j as usize), parts.radius[j as usize])
+                };
+                pairs.push(Pair { i: i as u32, j });
+                contacts.push(ContactForce {
+                    force: [o.ft[0] as f64, o.ft[1] as f64],
+                    point: g.point,
+                    n: g.n,
+                    f_n: o.info[0] as f64,
+                    f_t: o.info[1] as f64,
+                    overlap: o.info[2] as f64,
+                    energy: o.info[3] as f64,
+                });
+            }
+        }
+        self.sim.pairs = pairs;
+        self.sim.contacts = contacts;
+        self.sim.device_state = Some(ds);
+        self.synced = true;
+        &self.sim
+    }
+
+    /// The exact device state (for checkpoints).
+    pub fn device_state(&self) -> DeviceState {
+        let live = self.read_control()[control::LIVE] as usize;
+        let states = self.read_buffer(&self.buffers.state, 0, live);
+        let props = self.read_buffer(&self.buffers.props, 0, live);
+        let cap = self.params.table_mask as usize + 1;
+        let table: Vec<Entry> = self.read_buffer(&self.buffers.tables[self.parity], 0, cap);
+        let mut springs: Vec<Entry> = table.into_iter().filter(|e| e.i != EMPTY).collect();
+        springs.sort_by_key(|e| (e.i, e.j));
+        DeviceState { states, props, springs }
+    }
+
+    // ---- access for tests of single kernels ----
+
+    /// Overwrites the particle state on the device (tests).
+    pub fn upload_particles(&mut self, p: &Particles) {
+        let (s, pr) = to_device(p, self.origin, self.params.cell_size);
+        let s_buf = self.buffers.state.clone();
+        let p_buf = self.buffers.props.clone();
+        self.write_buffer(&s_buf, &s);
+        self.write_buffer(&p_buf, &pr);
+    }
+
+    /// Overwrites the spring table of the previous step (tests).
+    pub fn upload_springs(&mut self, entries: &[Entry]) {
+        let table = build_table(entries, self.params.table_mask as usize + 1);
+        let buf = self.buffers.tables[self.parity].clone();
+        self.write_buffer(&buf, &table);
+    }
+
+    /// Makes the table written by the last store_history the one read next (tests).
+    pub fn swap_springs(&mut self) {
+        self.parity = 1 - self.parity;
+    }
+
+    /// Overwrites contact lists and the history written by the force stage (tests).
+    pub fn upload_contacts(&mut self, count: &[u32], js: &[u32], hist_out: &[f32]) {
+        let (a, b, c) = (
+            self.buffers.contact_count.clone(),
+            self.buffers.contact_j.clone(),
+            self.buffers.hist_out.clone(),
+        );
+        self.write_buffer(&a, count);
+        self.write_buffer(&b, js);
+        self.write_buffer(&c, hist_out);
+    }
+
+    pub fn upload_cell_counts(&mut self, counts: &[u32]) {
+        let buf = self.buffers.cell_count.clone();
+        self.write_buffer(&buf, counts);
+    }
+
+    /// Reads a named per-step buffer as u32 words (tests).
+    pub fn read_u32(&self, name: &str, count: usize) -> Vec<u32> {
+        let b = &self.buffers;
+        let buf = match name {
+            "cell_of" => &b.cell_of,
+            "cell_count" => &b.cell_count,
+            "cell_start" => &b.cell_start,
+            "sorted" => &b.sorted,
+            "contact_j" => &b.contact_j,
+            "contact_count" => &b.contact_count,
+            "control" => &b.control,
+            _ => panic!("unknown buffer {name}"),
+        };
+        self.read_buffer(buf, 0, count)
+    }
+
+    pub fn read_f32(&self, name: &str, count: usize) -> Vec<f32> {
+        let b = &self.buffers;
+        let buf = match name {
+            "hist_in" => &b.hist_in,
+            "hist_out" => &b.hist_out,
+            _ => panic!("unknown buffer {name}"),
+        };
+        self.read_buffer(buf, 0, count)
+    }
+
+    pub fn read_forces(&self, count: usize) -> Vec<[f32; 4]> {
+        self.read_buffer(&self.buffers.force, 0, count)
+    }
+
+    pub fn read_contact_out(&self, count: usize) -> Vec<ContactOut> {
+        self.read_buffer(&self.buffers.contact_out, 0, count)
+    }
+}
+
+/// Splits a position relative to the grid origin into a cell anchor and an f32 offset
+/// in [0, cell).
+pub fn split(x: f64, z: f64, cell: f32) -> ([i32; 2], [f32; 2]) {
+    let l = cell as f64;
+    let one = |v: f64| {
+        let mut a = (v / l).floor();
+        let mut f = (v - a * l) as f32;
+        if f >= cell {
+            f -= cell;
+            a += 1.0;
+        }
+        if f < 0.0 {
+            f += cell;
+            a -= 1.0;
+        }
+        (a as i32, f)
+    };
+    let (ax, fx) = one(x);
+    let (az, fz) = one(z);
+    ([ax, az], [fx, fz])
+}
+
+/// Host f64 particles → device layout.
+pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec<Props>) {
+    let mut states = Vec::with_capacity(p.len());
+    let mut props = Vec::with_capacity(p.len());
+    for i in 0..p.len() {
+        let q0 = p.q[0][i];
+        let (anchor, frac) = split(q0[0] - origin[0], q0[1] - origin[1], cell);
+        let mut s = State {
+            anchor,
+            ..Default::default()
+        };
+        s.q[0] = [frac[0], frac[1], q0[2] as f32, 0.0];
+        for k in 1..GEAR_VALUES {
+            let v = p.q[k][i];
+            s.q[k] = [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
+        }
+        states.push(s);
+        let flags = (p.active[i] as u32) * ACTIVE | (p.fixed[i] as u32) * FIXED | (p.material[i] << 8);
+        props.push(Props {
+            radius: p.radius[i] as f32,
+            mass: p.mass[i] as f32,
+            inv_inertia: (1.0 / p.inertia[i]) as f32,
+            flags,
+        });
+    }
+    (states, props)
+}
+
+/// Device layout → host f64 particles.
+pub fn from_device(
+    states: &[State],
+    props: &[Props],
+    origin: [f64; 2],
+    cell: f32,
+) -> Particles {
+    let l = cell as f64;
+    let mut p = Particles::default();
+    for (s, pr) in states.iter().zip(props) {
+        p.q[0].push([
+            origin[0] + s.anchor[0] as f64 * l + s.q[0][0] as f64,
+            origin[1] + s.anchor[1] as f64 * l + s.q[0][1] as f64,
+            s.q[0][2] as f64,
+        ]);
+        for k in 1..GEAR_VALUES {
+            let v = s.q[k];
+            p.q[k].push([v[0] as f64, v[1] as f64, v[2] as f64]);
+        }
+        p.radius.push(pr.radius as f64);
+        p.mass.push(pr.mass as f64);
+        p.inertia.push(if pr.inv_inertia == 0.0 { f64::INFINITY } else { 1.0 / pr.inv_inertia as f64 });
+        p.fixed.push(pr.flags & FIXED != 0);
+        p.active.push(pr.flags & ACTIVE != 0);
+        p.material.push(pr.flags >> 8);
+    }
+    p
+}
+
+/// A spring table laid out as the kernels expect (host twin of `insert_new`).
+pub fn build_table(entries: &[Entry], cap: usize) -> Vec<Entry> {
+    let empty = Entry {
+        i: EMPTY,
+        ..Default::default()
+    };
+    let mut t = vec![empty; cap];
+    let mask = cap - 1;
+    for e in entries {
+        let mut slot = hash_pair(e.i, e.j) as usize & mask;
+        while t[slot].i != EMPTY {
+            slot = (slot + 1) & mask;
+        }
+        t[slot] = *e;
+    }
+    t
+}
+
+/// Looks a pair up in a device-layout table (host twin of `lookup_old`).
+pub fn table_lookup(table: &[Entry], i: u32, j: u32) -> Option<f32> {
+    let mask = table.len() - 1;
+    let mut slot = hash_pair(i, j) as usize & mask;
+    for _ in 0..table.len() {
+        let e = table[slot];
+        if e.i == EMPTY {
+            return None;
+        }
+        if e.i == i && e.j == j {
+            return Some(e.value);
+        }
+        slot = (slot + 1) & mask;
+    }
+    None
+}
+
+/// Law coefficients into Params.
+fn law_params(law: &ContactLaw, p: &mut Params) {
+    match law {
+        ContactLaw::SpringDashpot(l) => {
+            p.law = 0;
+            p.k_n = l.k_n as f32;
+            p.nu = l.nu as f32;
+            p.psi = l.psi as f32;
+            p.delta0 = l.delta0 as f32;
+            p.gamma_n = l.gamma_n as f32;
+            p.k_t = l.k_t as f32;
+            p.gamma_t = l.gamma_t as f32;
+            p.mu = l.mu as f32;
+            p.clamp = l.clamp as u32;
+        }
+        ContactLaw::Continuous(c) => {
+            p.law = 1;
+            match c.elastic {
+                crate::law::continuous::Elastic::Power { n } => {
+                    p.elastic = 0;
+                    p.n_exp = n as f32;
+                }
+                crate::law::continuous::Elastic::Hooke { k } => {
+                    p.elastic = 1;
+                    p.hooke_k = k as f32;
+                }
+            }
+            p.r0 = c.r0 as f32;
+            p.mu = c.mu as f32;
+            p.alpha = c.alpha as f32;
+            p.damping_fraction = c.damping_fraction as f32;
+            p.g_scale = c.g as f32;
+        }
+    }
+}

@@ -1,0 +1,307 @@
+//! Each GPU kernel against its CPU twin on random inputs (issue 3). The GPU works in
+//! f32, the CPU in f64; integer stages (cell list, prefix sum, contact lists, spring
+//! table) must agree exactly, float stages within the tolerances stated at each test.
+
+mod common;
+
+use serde_json::json;
+use std::collections::BTreeMap;
+use talus::cell_list::{CellList, Grid, prefix_sum};
+use talus::contacts::{Pair, find_contacts};
+use talus::forces::{contact_forces, reduce_forces};
+use talus::gpu::GpuSimulation;
+use talus::gpu::kernels::Kernel;
+use talus::gpu::layout::{Entry, MAX_CONTACTS};
+use talus::rng::Rng;
+
+/// `n` disks of diameter 0.8–1.2 on a jittered lattice in a box with walls, some
+/// overlapping, with random velocities and spins; every 7th one fixed.
+fn random_scene(n: usize, law: serde_json::Value, seed: u64) -> serde_json::Value {
+    let mut rng = Rng::new(seed);
+    let cols = (n as f64).sqrt().ceil() as usize;
+    let list: Vec<_> = (0..n)
+        .map(|k| {
+            let (c, r) = ((k % cols) as f64, (k / cols) as f64);
+            json!({
+                "position": [c * 1.0 + rng.range(-0.1, 0.1) + 0.7, r * 1.0 + rng.range(-0.1, 0.1) + 0.7],
+                "diameter": rng.range(0.8, 1.2),
+                "velocity": [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)],
+                "omega": rng.range(-2.0, 2.0),
+                "fixed": k % 7 == 3
+            })
+        })
+        .collect();
+    let w = cols as f64 + 1.5;
+    let mut v = common::scene_value(law, json!([{ "kind": "list", "material": "m", "particles": list }]));
+    v["dt"] = json!(2e-4);
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["domain"] = json!({ "x": [-3.0, w + 3.0], "z": [-3.0, w + 3.0] });
+    v["limits"] = json!({ "max_overlap": 0.9 });
+    v["walls"] = json!([{ "from": [0.0, 0.0], "to": [w, 0.0] }, { "from": [0.0, 0.0], "to": [0.0, w] },
+                        { "from": [w, 0.0], "to": [w, w] }]);
+    v
+}
+
+fn spring_dashpot() -> serde_json::Value {
+    json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 5.0, "k_t": 500.0, "gamma_t": 1.0, "mu": 0.5 })
+}
+
+fn continuous() -> serde_json::Value {
+    json!({ "law": "continuous", "n": 36.0, "r0": 1.2, "mu": 0.5 })
+}
+
+/// The CPU grid the GPU uses: the same origin, and the cell size rounded up to f32.
+fn gpu_grid(g: &GpuSimulation) -> Grid {
+    let mut grid = g.sim.grid.clone();
+    grid.cell_size = g.params.cell_size as f64;
+    grid
+}
+
+fn setup(test: &str, v: &serde_json::Value) -> Option<GpuSimulation> {
+    let gpu = common::gpu(test)?;
+    Some(GpuSimulation::with_gpu(common::sim(v), gpu).expect("uploads"))
+}
+
+/// Runs the cell list and find_contacts on the GPU; returns its pairs in list order.
+fn gpu_pairs(g: &mut GpuSimulation) -> Vec<Pair> {
+    let mut ks = GpuSimulation::CELL_LIST.to_vec();
+    ks.push(Kernel::FindContacts);
+    g.run_kernels(&ks);
+    let n = g.live() as usize;
+    let count = g.read_u32("contact_count", n);
+    let js = g.read_u32("contact_j", n * MAX_CONTACTS as usize);
+    let mut pairs = Vec::new();
+    for i in 0..n {
+        for k in 0..count[i] as usize {
+            pairs.push(Pair { i: i as u32, j: js[i * MAX_CONTACTS as usize + k] });
+        }
+    }
+    pairs
+}
+
+#[test]
+fn cell_list_matches_the_cpu() {
+    let Some(mut g) = setup("cell_list_matches_the_cpu", &random_scene(500, spring_dashpot(), 1)) else {
+        return;
+    };
+    g.run_kernels(&GpuSimulation::CELL_LIST);
+    let host = g.download().clone();
+    let grid = gpu_grid(&g);
+    let mut cpu = CellList::default();
+    cpu.build(&grid, &host.particles.q[0], &host.particles.active);
+    let n = host.particles.len();
+    let cells = grid.cell_count();
+    assert_eq!(g.read_u32("cell_of", n), cpu.cell_of, "cell of each particle");
+    assert_eq!(g.read_u32("cell_count", cells), cpu.count, "histogram");
+    assert_eq!(g.read_u32("cell_start", cells), cpu.start, "exclusive prefix sum");
+    // Within a cell the GPU order comes from atomics; as sets the cells must agree.
+    let mut sorted = g.read_u32("sorted", n);
+    for c in 0..cells {
+        let (a, b) = (cpu.start[c] as usize, (cpu.start[c] + cpu.count[c]) as usize);
+        sorted[a..b].sort_unstable();
+    }
+    assert_eq!(sorted, cpu.sorted, "scatter");
+}
+
+#[test]
+fn prefix_sum_matches_the_cpu_on_all_three_levels() {
+    // A domain of 400 × 400 cells: 160 000 counts, 625 level-1 blocks, 3 level-2 blocks.
+    let mut v = random_scene(20, spring_dashpot(), 2);
+    v["domain"] = json!({ "x": [-3.0, 397.0], "z": [-3.0, 397.0] });
+    let Some(mut g) = setup("prefix_sum_matches_the_cpu_on_all_three_levels", &v) else {
+        return;
+    };
+    let cells = g.params.cells as usize;
+    assert!(g.params.scan_blocks2 > 1, "the test must reach level 2");
+    let mut rng = Rng::new(5);
+    let counts: Vec<u32> = (0..cells).map(|_| (rng.uniform() * 4.0) as u32).collect();
+    g.upload_cell_counts(&counts);
+    g.run_kernels(&[
+        Kernel::ScanLevel0,
+        Kernel::ScanLevel1,
+        Kernel::ScanLevel2,
+        Kernel::ScanAdd1,
+        Kernel::ScanAdd0,
+    ]);
+    let mut expect = Vec::new();
+    prefix_sum(&counts, &mut expect);
+    assert_eq!(g.read_u32("cell_start", cells), expect);
+}
+
+#[test]
+fn find_contacts_matches_the_cpu_for_both_laws() {
+    for (name, law) in [("spring_dashpot", spring_dashpot()), ("continuous", continuous())] {
+        let Some(mut g) = setup("find_contacts_matches_the_cpu", &random_scene(600, law, 3)) else {
+            return;
+        };
+        let pairs = gpu_pairs(&mut g);
+        let host = g.download().clone();
+        let grid = gpu_grid(&g);
+        let mut cells = CellList::default();
+        cells.build(&grid, &host.particles.q[0], &host.particles.active);
+        let mut cpu = Vec::new();
+        find_contacts(&grid, &cells, &host.particles, &host.walls, host.law.range_factor(), &mut cpu);
+        assert!(cpu.len() > 500, "{name}: a dense packing ({} contacts)", cpu.len());
+        assert_eq!(pairs, cpu, "{name}: same contacts in the same order");
+    }
+}
+
+/// Relative difference scaled by a typical magnitude.
+fn rel(a: f64, b: f64, scale: f64) -> f64 {
+    (a - b).abs() / scale
+}
+
+#[test]
+fn contact_forces_and_reduction_match_the_cpu() {
+    // f32 against f64: geometry carries ~1e-7 of a diameter, and the overlaps here are
+    // 1e-2..1e-1 of a diameter, so forces agree to ~1e-5 of the largest contact force;
+    // 1e-4 leaves room for the velocity terms and the 6-10 term sums.
+    for (name, law) in [("spring_dashpot", spring_dashpot()), ("continuous", continuous())] {
+        let Some(mut g) = setup("contact_forces_match_the_cpu", &random_scene(400, law, 4)) else {
+            return;
+        };
+        let pairs = gpu_pairs(&mut g);
+        // Give every contact a previous history so the tangential laws are exercised.
+        let mut rng = Rng::new(9);
+        let entries: Vec<Entry> = pairs
+            .iter()
+            .map(|p| Entry { i: p.i, j: p.j, value: rng.range(-2e-3, 2e-3) as f32, _pad: 0 })
+            .collect();
+        g.upload_springs(&entries);
+        g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces, Kernel::ReduceForces]);
+        let host = g.download().clone();
+        let history: Vec<f64> = entries.iter().map(|e| e.value as f64).collect();
+        let n = host.particles.len();
+        let hist_in = g.read_f32("hist_in", n * MAX_CONTACTS as usize);
+        let count = g.read_u32("contact_count", n);
+        let mut k_global = 0;
+        for i in 0..n {
+            for k in 0..count[i] as usize {
+                assert_eq!(hist_in[i * MAX_CONTACTS as usize + k], entries[k_global].value, "{name}: gathered history");
+                k_global += 1;
+            }
+        }
+        let (mut cpu, mut hist_out) = (Vec::new(), Vec::new());
+        contact_forces(&host.particles, &host.walls, &host.law, host.dt(), &pairs, &history, &mut cpu, &mut hist_out);
+        let scale = cpu.iter().map(|c| c.f_n.abs()).fold(0.0, f64::max);
+        assert!(scale > 0.0);
+        let out = g.read_contact_out(n * MAX_CONTACTS as usize);
+        let gpu_hist = g.read_f32("hist_out", n * MAX_CONTACTS as usize);
+        let mut worst: f64 = 0.0;
+        let mut k_global = 0;
+        let hscale = hist_out.iter().map(|h| h.abs()).fold(1e-12, f64::max);
+        for i in 0..n {
+            for k in 0..count[i] as usize {
+                let o = out[i * MAX_CONTACTS as usize + k];
+                let c = cpu[k_global];
+                worst = worst
+                    .max(rel(o.ft[0] as f64, c.force[0], scale))
+                    .max(rel(o.ft[1] as f64, c.force[1], scale))
+                    .max(rel(o.info[0] as f64, c.f_n, scale))
+                    .max(rel(o.info[1] as f64, c.f_t, scale));
+                let dh = rel(gpu_hist[i * MAX_CONTACTS as usize + k] as f64, hist_out[k_global], hscale);
+                assert!(dh < 1e-4, "{name}: history of contact {k_global} {:?} differs by {dh:.2e}: gpu {} cpu {} (in {}), gpu out {:?} cpu {:?}", pairs[k_global], gpu_hist[i * MAX_CONTACTS as usize + k], hist_out[k_global], history[k_global], o, c);
+                k_global += 1;
+            }
+        }
+        assert!(worst < 1e-4, "{name}: forces differ by {worst:.2e} of the largest");
+        let mut f = Vec::new();
+        reduce_forces(&host.particles, &pairs, &cpu, &mut f);
+        let gf = g.read_forces(n);
+        let tscale = scale * 1.2;
+        for i in 0..n {
+            for d in 0..3 {
+                let s = if d == 2 { tscale } else { scale };
+                let e = rel(gf[i][d] as f64, f[i][d], s);
+                assert!(e < 1e-4, "{name}: reduced force {d} of particle {i} differs by {e:.2e}");
+            }
+        }
+    }
+}
+
+#[test]
+fn spring_table_survives_contact_churn() {
+    // 300 particles, random contact lists that persist (80 %), open and close each step;
+    // the GPU table must give back exactly the value stored for every persisting pair
+    // and 0 for every new one, never losing or duplicating a spring.
+    let Some(mut g) = setup("spring_table_survives_contact_churn", &random_scene(300, spring_dashpot(), 6))
+    else {
+        return;
+    };
+    let n = g.live() as usize;
+    let m = MAX_CONTACTS as usize;
+    let mut rng = Rng::new(11);
+    let mut reference: BTreeMap<(u32, u32), f32> = BTreeMap::new();
+    for step in 0..40 {
+        let mut lists: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for &(i, j) in reference.keys() {
+            if rng.uniform() < 0.8 {
+                lists[i as usize].push(j);
+            }
+        }
+        for _ in 0..200 {
+            let i = (rng.uniform() * (n - 1) as f64) as usize;
+            let j = (i + 1 + (rng.uniform() * 30.0) as usize).min(n - 1) as u32;
+            lists[i].push(if rng.uniform() < 0.1 { 0xFFFF_0000 + (rng.uniform() * 3.0) as u32 } else { j });
+        }
+        let (mut count, mut js, mut values) = (vec![0u32; n], vec![0u32; n * m], vec![0f32; n * m]);
+        let mut next = BTreeMap::new();
+        for (i, l) in lists.iter_mut().enumerate() {
+            l.sort_unstable();
+            l.dedup();
+            l.truncate(m);
+            count[i] = l.len() as u32;
+            for (k, &j) in l.iter().enumerate() {
+                js[i * m + k] = j;
+                let v = (step * 1000 + i * 16 + k) as f32;
+                values[i * m + k] = v;
+                next.insert((i as u32, j), v);
+            }
+        }
+        g.upload_contacts(&count, &js, &values);
+        g.run_kernels(&[Kernel::GatherHistory]);
+        let hist = g.read_f32("hist_in", n * m);
+        for i in 0..n {
+            for k in 0..count[i] as usize {
+                let j = js[i * m + k];
+                let want = reference.get(&(i as u32, j)).copied().unwrap_or(0.0);
+                assert_eq!(hist[i * m + k], want, "step {step}: pair ({i}, {j})");
+            }
+        }
+        g.run_kernels(&[Kernel::ClearTable, Kernel::StoreHistory]);
+        g.swap_springs();
+        let stored = g.download().springs.len();
+        assert_eq!(stored, next.len(), "step {step}: no lost or duplicated springs");
+        reference = next;
+    }
+}
+
+#[test]
+fn one_step_of_each_integrator_matches_the_cpu() {
+    // A whole step (predict, contacts, forces, correct, boundaries) from the same f32
+    // state. Positions move by ~v dt = 2e-4 per step; f32 offsets carry 6e-8 of a cell,
+    // so positions agree to 1e-6 and scaled velocities q1 to 1e-3 of their size.
+    for integrator in ["gear5", "leapfrog"] {
+        let mut v = random_scene(300, spring_dashpot(), 7);
+        v["integrator"] = json!(integrator);
+        let Some(mut g) = setup("one_step_of_each_integrator_matches_the_cpu", &v) else {
+            return;
+        };
+        // Start both from the f32-rounded state.
+        let mut cpu = g.download().clone();
+        g.advance(1).expect("no divergence");
+        cpu.step().expect("no divergence");
+        let host = g.download();
+        let q1_scale = cpu.particles.q[1].iter().map(|q| q[0].abs().max(q[1].abs())).fold(0.0, f64::max);
+        for i in 0..cpu.particles.len() {
+            let (a, b) = (host.particles.q[0][i], cpu.particles.q[0][i]);
+            for d in 0..3 {
+                assert!((a[d] - b[d]).abs() < 1e-6, "{integrator}: q0[{d}] of {i}: {} vs {}", a[d], b[d]);
+            }
+            let (a, b) = (host.particles.q[1][i], cpu.particles.q[1][i]);
+            for d in 0..2 {
+                assert!(rel(a[d], b[d], q1_scale) < 1e-3, "{integrator}: q1[{d}] of {i}: {} vs {}", a[d], b[d]);
+            }
+        }
+    }
+}
