@@ -58,6 +58,21 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
     e.u64(sim.springs.capacity() as u64);
     sim.springs.keys.iter().for_each(|&k| e.u64(k));
     sim.springs.values.iter().for_each(|&v| e.f64(v));
+    // From a GPU run: the exact device state, for a bitwise GPU resume.
+    match &sim.device_state {
+        Some(ds) => {
+            e.u8(1);
+            for raw in [
+                bytemuck::cast_slice::<_, u8>(&ds.states),
+                bytemuck::cast_slice(&ds.props),
+                bytemuck::cast_slice(&ds.springs),
+            ] {
+                e.u64(raw.len() as u64);
+                e.bytes.extend_from_slice(raw);
+            }
+        }
+        None => e.u8(0),
+    }
     e.bytes
 }
 
@@ -149,9 +164,33 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
     for _ in 0..cap {
         springs.values.push(d.f64().map_err(corrupt)?);
     }
+    let device_state = if d.u8().map_err(corrupt)? == 1 {
+        let mut raw = || -> Result<&[u8], crate::files::DecodeError> {
+            let n = d.u64()? as usize;
+            d.take(n)
+        };
+        let states = raw().map_err(corrupt)?;
+        let props = raw().map_err(corrupt)?;
+        let springs = raw().map_err(corrupt)?;
+        let sizes_ok = states.len() % size_of::<crate::gpu::layout::State>() == 0
+            && props.len() % size_of::<crate::gpu::layout::Props>() == 0
+            && springs.len() % size_of::<crate::gpu::layout::Entry>() == 0;
+        if !sizes_ok {
+            return Err(corrupt(crate::files::DecodeError(bytes.len())));
+        }
+        Some(crate::gpu::DeviceState {
+            states: bytemuck::pod_collect_to_vec(states),
+            props: bytemuck::pod_collect_to_vec(props),
+            springs: bytemuck::pod_collect_to_vec(springs),
+        })
+    } else {
+        None
+    };
     if !d.is_done() || !cap.is_power_of_two() {
         return Err(corrupt(crate::files::DecodeError(bytes.len())));
     }
-    Simulation::from_parts(scene, p, springs, sources, rng, step, lost)
-        .map_err(|e| CheckpointError::Scene(name, e))
+    let mut sim = Simulation::from_parts(scene, p, springs, sources, rng, step, lost)
+        .map_err(|e| CheckpointError::Scene(name, e))?;
+    sim.device_state = device_state;
+    Ok(sim)
 }

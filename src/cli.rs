@@ -1,10 +1,13 @@
 //! Command line: clap turns arguments into a validated scene and options; errors are
 //! printed once here. Exit codes: 0 success, 1 failed run (divergence, I/O), 2 bad input.
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use talus::{checkpoint, run, scene, sim::Simulation};
+use talus::gpu::GpuSimulation;
+use talus::gpu::device::{self, BackendChoice as Backend};
+use talus::run::Engine;
+use talus::{bench, checkpoint, run, scene, sim::Simulation};
 
 #[derive(Parser)]
 #[command(
@@ -46,13 +49,26 @@ enum Command {
     },
     /// Print the built-in default scene.
     DefaultScene,
-}
-
-#[derive(Clone, Copy, ValueEnum, PartialEq)]
-enum Backend {
-    Auto,
-    Cpu,
-    Gpu,
+    /// List the GPU adapters, the limits talus uses, and what a run would choose.
+    Info,
+    /// Measure particle-steps per second per backend and workload; prints JSON.
+    Bench {
+        /// Backends to measure.
+        #[arg(long, value_enum, default_values_t = [Backend::Cpu, Backend::Gpu])]
+        backend: Vec<Backend>,
+        /// Packing sizes (disks) of the settled-packing workloads.
+        #[arg(long, value_delimiter = ',', default_values_t = [1000, 10000, 100000])]
+        sizes: Vec<usize>,
+        /// Steps timed per workload (after a warm-up of a tenth as many).
+        #[arg(long, default_value_t = 200)]
+        steps: u64,
+        /// Also time the reduced R4 pour.
+        #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+        pour: bool,
+        /// Write the JSON here too (atomically).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 /// A failed command: its exit code and the message printed once by `main`.
@@ -85,6 +101,17 @@ pub fn main() -> ExitCode {
             print!("{}", scene::DEFAULT_SCENE);
             Ok(())
         }
+        Command::Info => {
+            print!("{}", device::describe());
+            Ok(())
+        }
+        Command::Bench {
+            backend,
+            sizes,
+            steps,
+            pour,
+            out,
+        } => cmd_bench(&backend, &sizes, steps, pour, out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -133,18 +160,7 @@ fn cmd_run(
     backend: Backend,
     quiet: bool,
 ) -> Result<(), Failure> {
-    match backend {
-        Backend::Gpu => {
-            return Err(bad_input(
-                "the GPU path is not implemented yet; use --backend cpu",
-            ));
-        }
-        Backend::Auto if !quiet => {
-            eprintln!("note: using the CPU reference path (the GPU path is not implemented yet)")
-        }
-        _ => {}
-    }
-    let mut sim = match &resume {
+    let sim = match &resume {
         Some(ckpt) => checkpoint::read(ckpt, &overrides).map_err(bad_input)?,
         None => build_simulation(&path, &overrides)?,
     };
@@ -159,8 +175,12 @@ fn cmd_run(
             out.display()
         );
     }
+    let mut engine = choose_engine(sim, backend, quiet)?;
+    if !quiet {
+        eprintln!("backend: {}", engine.name());
+    }
     let s = run::run(
-        &mut sim,
+        &mut engine,
         &run::RunOptions {
             out: out.clone(),
             quiet,
@@ -181,6 +201,70 @@ fn cmd_run(
             s.particle_steps_per_second,
             out.display()
         );
+    }
+    Ok(())
+}
+
+/// The engine for `--backend`: `gpu` insists on a GPU adapter; `auto` takes a hardware
+/// GPU when there is one and otherwise the CPU path, saying why. A software adapter
+/// (lavapipe) counts as no GPU for `auto`: the CPU path is faster than it.
+fn choose_engine(sim: Simulation, backend: Backend, quiet: bool) -> Result<Engine, Failure> {
+    let run_failure = |e: &dyn std::fmt::Display| Failure {
+        code: 1,
+        message: e.to_string(),
+    };
+    match backend {
+        Backend::Cpu => Ok(Engine::cpu(sim)),
+        Backend::Gpu => GpuSimulation::new(sim)
+            .map(|g| Engine::Gpu(Box::new(g)))
+            .map_err(|e| run_failure(&e)),
+        Backend::Auto => {
+            let why = match device::choose_adapter() {
+                Ok(a) if a.get_info().device_type == wgpu::DeviceType::Cpu => format!(
+                    "only a software GPU adapter ({}) was found, and the CPU path is faster; \
+                     --backend gpu uses it anyway",
+                    a.get_info().name
+                ),
+                Ok(_) => {
+                    return match GpuSimulation::new(sim.clone()) {
+                        Ok(g) => Ok(Engine::Gpu(Box::new(g))),
+                        Err(e) => {
+                            if !quiet {
+                                eprintln!("note: the GPU path is unavailable ({e}); using the CPU reference path");
+                            }
+                            Ok(Engine::cpu(sim))
+                        }
+                    };
+                }
+                Err(e) => e.to_string(),
+            };
+            if !quiet {
+                eprintln!("note: using the CPU reference path: {why}");
+            }
+            Ok(Engine::cpu(sim))
+        }
+    }
+}
+
+fn cmd_bench(
+    backends: &[Backend],
+    sizes: &[usize],
+    steps: u64,
+    pour: bool,
+    out: Option<PathBuf>,
+) -> Result<(), Failure> {
+    let report = bench::run(backends, sizes, steps, pour, &mut |line| eprintln!("{line}"))
+        .map_err(|e| Failure {
+            code: 1,
+            message: e,
+        })?;
+    let text = serde_json::to_string_pretty(&report).expect("report serialises");
+    println!("{text}");
+    if let Some(path) = out {
+        talus::files::write_atomic(&path, text.as_bytes()).map_err(|e| Failure {
+            code: 1,
+            message: format!("cannot write {}: {e}", path.display()),
+        })?;
     }
     Ok(())
 }

@@ -3,6 +3,7 @@
 //! written atomically; `summary.json` is written last and marks a complete run.
 
 use crate::files::write_atomic;
+use crate::gpu::GpuSimulation;
 use crate::progress::Progress;
 use crate::sim::{Divergence, Simulation};
 use crate::{checkpoint, snapshot};
@@ -61,6 +62,67 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
     }
 }
 
+/// The path that advances the state: the CPU reference path or the GPU path. Outputs
+/// always read the host `Simulation` (for the GPU, a mirror refreshed by `download`).
+pub enum Engine {
+    Cpu(Box<Simulation>),
+    Gpu(Box<GpuSimulation>),
+}
+
+impl Engine {
+    pub fn cpu(mut sim: Simulation) -> Self {
+        // A state loaded from a GPU checkpoint carries the device state; the CPU path
+        // continues from the f64 state instead and must not write the stale copy.
+        sim.device_state = None;
+        Self::Cpu(Box::new(sim))
+    }
+
+    pub fn name(&self) -> String {
+        match self {
+            Self::Cpu(_) => "cpu".into(),
+            Self::Gpu(g) => format!("gpu ({})", g.adapter_name()),
+        }
+    }
+
+    pub fn step(&self) -> u64 {
+        match self {
+            Self::Cpu(s) => s.step,
+            Self::Gpu(g) => g.step(),
+        }
+    }
+
+    /// Active particles now (no readback on the GPU).
+    pub fn active_count(&self) -> u64 {
+        match self {
+            Self::Cpu(s) => s.particles.active_count() as u64,
+            Self::Gpu(g) => g.active_count(),
+        }
+    }
+
+    pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
+        match self {
+            Self::Cpu(s) => (0..steps).try_for_each(|_| s.step()),
+            Self::Gpu(g) => g.advance(steps),
+        }
+    }
+
+    /// The host state, current (reads the device back on the GPU path).
+    pub fn sim(&mut self) -> &Simulation {
+        match self {
+            Self::Cpu(s) => s,
+            Self::Gpu(g) => g.download(),
+        }
+    }
+
+    /// The host copy without a readback: scene, law and grid are always current.
+    pub fn host(&self) -> &Simulation {
+        match self {
+            Self::Cpu(s) => s,
+            Self::Gpu(g) => &g.sim,
+        }
+    }
+}
+
 /// Steps between events that happen every `interval` of simulated time (0 = never).
 fn every(interval: f64, dt: f64) -> Option<u64> {
     (interval > 0.0).then(|| ((interval / dt).round() as u64).max(1))
@@ -71,7 +133,7 @@ pub fn total_steps(sim: &Simulation) -> u64 {
     (sim.scene.stop.time / sim.dt() - 1e-9).ceil() as u64
 }
 
-pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunError> {
+pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunError> {
     let out = &opts.out;
     std::fs::create_dir_all(out).map_err(io(out))?;
     // A summary marks a finished run; one left by an earlier run in this folder must not
@@ -80,45 +142,63 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
     if summary_path.exists() {
         std::fs::remove_file(&summary_path).map_err(io(&summary_path))?;
     }
+    let scene = engine.host().scene.clone();
     let scene_path = out.join("scene.json");
-    let text = serde_json::to_string_pretty(&sim.scene).expect("a scene always serialises");
+    let text = serde_json::to_string_pretty(&scene).expect("a scene always serialises");
     write_atomic(&scene_path, text.as_bytes()).map_err(io(&scene_path))?;
 
-    let dt = sim.dt();
-    let o = sim.scene.output.clone();
+    let dt = scene.dt;
+    let o = scene.output.clone();
     let snap_every = every(o.snapshot_every, dt);
-    let ckpt_every = every(o.checkpoint_every.unwrap_or(0.1 * sim.scene.stop.time), dt);
+    let ckpt_every = every(o.checkpoint_every.unwrap_or(0.1 * scene.stop.time), dt);
     let log_every = every(
         if o.log_every > 0.0 {
             o.log_every
         } else {
-            sim.scene.stop.time / 200.0
+            scene.stop.time / 200.0
         },
         dt,
     );
-    let check_every = every(sim.scene.stop.check_every, dt).unwrap_or(1);
-    let total = total_steps(sim);
+    let check_every = every(scene.stop.check_every, dt).unwrap_or(1);
+    let total = total_steps(engine.host());
     let snap_dir = out.join("snapshots");
     let ckpt_dir = out.join("checkpoints");
+    let time = |step: u64| step as f64 * dt;
 
-    let mut progress = Progress::new(sim.step, total, opts.quiet);
+    let mut progress = Progress::new(engine.step(), total, opts.quiet);
     let start = Instant::now();
-    let start_step = sim.step;
+    let start_step = engine.step();
     let mut particle_steps = 0u64;
     let mut log = String::from(
         "step,time,particles,contacts,kinetic_translational,kinetic_rotational,elastic,potential\n",
     );
     let mut checkpoints: Vec<PathBuf> = Vec::new();
     let mut settled = false;
-    if sim.step == 0 && snap_every.is_some() {
-        let p =
-            snapshot::write(sim, &snap_dir, &format!("snap_{:010}", 0)).map_err(io(&snap_dir))?;
-        let _ = p;
+    if engine.step() == 0 && snap_every.is_some() {
+        snapshot::write(engine.sim(), &snap_dir, &format!("snap_{:010}", 0))
+            .map_err(io(&snap_dir))?;
     }
+    // The next step at which anything happens: an output, the settling check, or a
+    // progress update. The engine runs freely in between (on the GPU: many steps per
+    // submission).
+    let due = |step: u64, k: Option<u64>| k.map_or(u64::MAX, |k| (step / k + 1) * k);
+    const PROGRESS_EVERY: u64 = 256;
 
-    while sim.step < total {
-        let active = sim.particles.active_count() as u64;
-        if let Err(cause) = sim.step() {
+    while engine.step() < total {
+        let now = engine.step();
+        let next = [
+            due(now, log_every),
+            due(now, snap_every),
+            due(now, ckpt_every),
+            due(now, Some(check_every)),
+            due(now, Some(PROGRESS_EVERY)),
+            total,
+        ]
+        .into_iter()
+        .min()
+        .unwrap_or(total);
+        let active = engine.active_count();
+        if let Err(cause) = engine.advance(next - now) {
             progress.finish();
             let checkpoint = match checkpoints.last() {
                 Some(p) => format!(
@@ -131,16 +211,18 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
                         .into()
                 }
             };
+            let step = engine.step();
             return Err(RunError::Diverged {
-                step: sim.step,
-                time: sim.time(),
+                step,
+                time: time(step),
                 cause,
                 checkpoint,
             });
         }
-        particle_steps += active;
-        let step = sim.step;
+        particle_steps += active * (next - now);
+        let step = next;
         if log_every.is_some_and(|k| step.is_multiple_of(k)) {
+            let sim = engine.sim();
             let e = sim.energies();
             log.push_str(&format!(
                 "{step},{:.9e},{},{},{:.9e},{:.9e},{:.9e},{:.9e}\n",
@@ -154,36 +236,41 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
             ));
         }
         if snap_every.is_some_and(|k| step.is_multiple_of(k)) {
-            snapshot::write(sim, &snap_dir, &format!("snap_{step:010}")).map_err(io(&snap_dir))?;
+            snapshot::write(engine.sim(), &snap_dir, &format!("snap_{step:010}"))
+                .map_err(io(&snap_dir))?;
         }
         if ckpt_every.is_some_and(|k| step.is_multiple_of(k)) {
-            write_checkpoint(sim, &ckpt_dir, &mut checkpoints)?;
+            write_checkpoint(engine.sim(), &ckpt_dir, &mut checkpoints)?;
             let log_path = out.join("log.csv");
             write_atomic(&log_path, log.as_bytes()).map_err(io(&log_path))?;
         }
         if step.is_multiple_of(check_every) {
-            progress.update(step, sim.time(), sim.particles.active_count());
-            if let Some(frac) = sim.scene.stop.kinetic_fraction
-                && sim.time() >= sim.scene.stop.not_before
-                && sim.feeding_done()
+            progress.update(step, time(step), engine.active_count() as usize);
+            if let Some(frac) = scene.stop.kinetic_fraction
+                && time(step) >= scene.stop.not_before
             {
-                let e = sim.energies();
-                if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
-                    progress.note(&format!(
-                        "settled at t = {:.4}: kinetic/elastic = {:.3e}",
-                        sim.time(),
-                        e.kinetic() / e.elastic
-                    ));
-                    settled = true;
-                    break;
+                let sim = engine.sim();
+                if sim.feeding_done() {
+                    let e = sim.energies();
+                    if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
+                        progress.note(&format!(
+                            "settled at t = {:.4}: kinetic/elastic = {:.3e}",
+                            sim.time(),
+                            e.kinetic() / e.elastic
+                        ));
+                        settled = true;
+                        break;
+                    }
                 }
             }
-        } else if step.is_multiple_of(256) {
-            progress.update(step, sim.time(), sim.particles.active_count());
+        } else if step.is_multiple_of(PROGRESS_EVERY) {
+            progress.update(step, time(step), engine.active_count() as usize);
         }
     }
     progress.finish();
 
+    let backend = engine.name();
+    let sim = engine.sim();
     if checkpoints
         .last()
         .is_none_or(|p| !p.ends_with(format!("ckpt_{:010}.bin", sim.step)))
@@ -198,7 +285,7 @@ pub fn run(sim: &mut Simulation, opts: &RunOptions) -> Result<RunSummary, RunErr
     let e = sim.energies();
     let summary = RunSummary {
         scene: sim.scene.name.clone(),
-        backend: "cpu".into(),
+        backend,
         steps: sim.step - start_step,
         time: sim.time(),
         particles: sim.particles.active_count(),

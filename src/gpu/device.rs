@@ -186,6 +186,12 @@ pub fn describe() -> String {
         }
     }
     let _ = match choose_adapter() {
+        Ok(a) if a.get_info().device_type == wgpu::DeviceType::Cpu => writeln!(
+            s,
+            "--backend gpu would run on: {} (a software adapter)\n--backend auto would run on \
+             the CPU reference path, which is faster than a software adapter",
+            a.get_info().name
+        ),
         Ok(a) => writeln!(
             s,
             "--backend auto or gpu would run on: {}",

@@ -80,8 +80,11 @@ pub struct GpuSimulation {
     n_cap: u32,
     origin: [f64; 2],
     sources: Vec<SourceBase>,
-    /// Particles and loss count at upload (the GPU counts from there).
+    /// Loss count at upload (the GPU counts from there), inactive particles at upload,
+    /// and losses on the device after the last submission.
     lost_base: u64,
+    inactive_at_upload: u64,
+    lost_now: u64,
     /// The step the device is at (known on the host without a readback).
     step: u64,
     live: u32,
@@ -391,6 +394,7 @@ impl GpuSimulation {
         };
         let group1 = [pair_group(0), pair_group(1)];
         let lost_base = sim.lost;
+        let inactive_at_upload = (sim.particles.len() - sim.particles.active_count()) as u64;
         let step = sim.step;
         Ok(Self {
             sim,
@@ -405,6 +409,8 @@ impl GpuSimulation {
             origin,
             sources,
             lost_base,
+            inactive_at_upload,
+            lost_now: 0,
             step,
             live: n_now,
             synced: true,
@@ -423,6 +429,11 @@ impl GpuSimulation {
     /// Particles created so far (active or lost).
     pub fn live(&self) -> u32 {
         self.live
+    }
+
+    /// Active particles after the last submission (from the control words).
+    pub fn active_count(&self) -> u64 {
+        (self.live as u64).saturating_sub(self.inactive_at_upload + self.lost_now)
     }
 
     fn dispatch(&self, pass: &mut wgpu::ComputePass, k: Kernel, groups: u64) {
@@ -533,6 +544,7 @@ impl GpuSimulation {
             self.synced = false;
             let c = self.read_control();
             self.live = c[control::LIVE];
+            self.lost_now = c[control::LOST] as u64;
             if c[control::HALT] != 0 {
                 return Err(self.halt_cause(&c));
             }

@@ -1,0 +1,148 @@
+//! Benchmark workloads (`talus bench`, `benches/`): particle-steps per second of each
+//! backend on settled disk packings of several sizes and on the reduced R4 pour.
+//!
+//! A "settled packing" is a triangular block of equal disks resting on a floor between
+//! two walls, slightly compressed by gravity: every disk has four to six contacts, as in
+//! the interior of a heap. The first tenth of the steps is a warm-up and not timed.
+
+use crate::gpu::GpuSimulation;
+use crate::gpu::device::BackendChoice;
+use crate::run::Engine;
+use crate::scene;
+use crate::sim::Simulation;
+use serde::Serialize;
+use serde_json::json;
+use std::time::Instant;
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Measurement {
+    pub workload: String,
+    pub backend: String,
+    pub shape: String,
+    pub particles: u64,
+    pub steps: u64,
+    pub seconds: f64,
+    pub particle_steps_per_second: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Report {
+    pub cpu: String,
+    pub cores: usize,
+    pub results: Vec<Measurement>,
+}
+
+/// A triangular packing of `n` unit disks, about twice as wide as high, on a floor.
+pub fn packing_scene(n: usize) -> String {
+    let cols = ((2.0 * n as f64).sqrt().ceil() as usize).max(2);
+    let h = 3f64.sqrt() / 2.0;
+    let mut list = Vec::with_capacity(n);
+    for k in 0..n {
+        let (c, r) = (k % cols, k / cols);
+        let x = c as f64 + if r % 2 == 1 { 0.5 } else { 0.0 } + 0.5;
+        list.push(json!({ "position": [x, 0.5 + r as f64 * h], "diameter": 1.0 }));
+    }
+    let w = cols as f64 + 1.0;
+    let top = (n / cols + 2) as f64 * h + 2.0;
+    json!({
+        "name": format!("packing-{n}"),
+        "dt": 0.002,
+        "stop": { "time": 1e9 },
+        "gravity": { "g": [0.0, -1.0] },
+        "domain": { "x": [-2.0, w + 2.0], "z": [-2.0, top] },
+        "materials": { "m": { "density": 1.2732395447351628 } },
+        "contact": { "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 10.0, "k_t": 571.4,
+                     "gamma_t": 2.0, "mu": 0.5 },
+        "walls": [{ "from": [0.0, 0.0], "to": [w, 0.0] }, { "from": [0.0, 0.0], "to": [0.0, top] },
+                  { "from": [w, 0.0], "to": [w, top] }],
+        "particles": [{ "kind": "list", "material": "m", "particles": list }],
+        "output": { "checkpoint_every": 0 }
+    })
+    .to_string()
+}
+
+fn engine(sim: Simulation, backend: BackendChoice) -> Result<Engine, String> {
+    match backend {
+        BackendChoice::Gpu => GpuSimulation::new(sim)
+            .map(|g| Engine::Gpu(Box::new(g)))
+            .map_err(|e| e.to_string()),
+        _ => Ok(Engine::cpu(sim)),
+    }
+}
+
+/// Times `steps` steps after a warm-up; the particle count is the mean of start and end.
+fn measure(
+    workload: &str,
+    sim: Simulation,
+    backend: BackendChoice,
+    steps: u64,
+) -> Result<Measurement, String> {
+    let mut e = engine(sim, backend)?;
+    e.advance((steps / 10).max(1)).map_err(|d| d.to_string())?;
+    let n0 = e.active_count();
+    let t = Instant::now();
+    e.advance(steps).map_err(|d| d.to_string())?;
+    let seconds = t.elapsed().as_secs_f64();
+    let n = (n0 + e.active_count()) / 2;
+    Ok(Measurement {
+        workload: workload.into(),
+        backend: e.name(),
+        shape: "disk".into(),
+        particles: n,
+        steps,
+        seconds,
+        particle_steps_per_second: (n * steps) as f64 / seconds.max(1e-12),
+    })
+}
+
+fn cpu_name() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|v| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown".into())
+}
+
+/// Runs every workload on every backend; `log` receives one line per measurement.
+pub fn run(
+    backends: &[BackendChoice],
+    sizes: &[usize],
+    steps: u64,
+    pour: bool,
+    log: &mut dyn FnMut(String),
+) -> Result<Report, String> {
+    let mut results = Vec::new();
+    let mut workloads: Vec<(String, String)> = sizes
+        .iter()
+        .map(|&n| (format!("packing-{n}"), packing_scene(n)))
+        .collect();
+    if pour {
+        workloads.push((
+            "r4-pour-reduced".into(),
+            include_str!("../scenes/r4_pour_reduced.json").into(),
+        ));
+    }
+    for (name, text) in &workloads {
+        let scene = scene::parse(text, &[]).map_err(|e| format!("{name}: {e}"))?;
+        for &b in backends {
+            let sim = Simulation::new(scene.clone()).map_err(|e| e.to_string())?;
+            // The pour starts nearly empty: time ten times longer to see it fill.
+            let k = if name.starts_with("r4") { 10 * steps } else { steps };
+            let m = measure(name, sim, b, k)?;
+            log(format!(
+                "{:>18} {:>28} {:>7} particles {:>10.3e} particle-steps/s",
+                m.workload, m.backend, m.particles, m.particle_steps_per_second
+            ));
+            results.push(m);
+        }
+    }
+    Ok(Report {
+        cpu: cpu_name(),
+        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        results,
+    })
+}
