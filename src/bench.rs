@@ -131,7 +131,11 @@ pub fn run(
         for &b in backends {
             let sim = Simulation::new(scene.clone()).map_err(|e| e.to_string())?;
             // The pour starts nearly empty: time ten times longer to see it fill.
-            let k = if name.starts_with("r4") { 10 * steps } else { steps };
+            let k = if name.starts_with("r4") {
+                10 * steps
+            } else {
+                steps
+            };
             let m = measure(name, sim, b, k)?;
             log(format!(
                 "{:>18} {:>28} {:>7} particles {:>10.3e} particle-steps/s",

@@ -230,7 +230,9 @@ fn choose_engine(sim: Simulation, backend: Backend, quiet: bool) -> Result<Engin
                         Ok(g) => Ok(Engine::Gpu(Box::new(g))),
                         Err(e) => {
                             if !quiet {
-                                eprintln!("note: the GPU path is unavailable ({e}); using the CPU reference path");
+                                eprintln!(
+                                    "note: the GPU path is unavailable ({e}); using the CPU reference path"
+                                );
                             }
                             Ok(Engine::cpu(sim))
                         }
@@ -253,11 +255,13 @@ fn cmd_bench(
     pour: bool,
     out: Option<PathBuf>,
 ) -> Result<(), Failure> {
-    let report = bench::run(backends, sizes, steps, pour, &mut |line| eprintln!("{line}"))
-        .map_err(|e| Failure {
-            code: 1,
-            message: e,
-        })?;
+    let report = bench::run(backends, sizes, steps, pour, &mut |line| {
+        eprintln!("{line}")
+    })
+    .map_err(|e| Failure {
+        code: 1,
+        message: e,
+    })?;
     let text = serde_json::to_string_pretty(&report).expect("report serialises");
     println!("{text}");
     if let Some(path) = out {

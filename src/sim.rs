@@ -233,13 +233,8 @@ impl Simulation {
                 continue;
             };
             let material = create::material_index(&self.scene, &spec.material);
-            let disks = create::source::emit(
-                spec,
-                &mut self.sources[k],
-                t,
-                material,
-                &self.particles,
-            );
+            let disks =
+                create::source::emit(spec, &mut self.sources[k], t, material, &self.particles);
             for d in disks {
                 let id = create::push(&self.scene, &mut self.particles, &d) as usize;
                 let h = 0.5 * self.scene.dt * self.scene.dt;

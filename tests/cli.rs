@@ -162,15 +162,29 @@ fn diverging_run_stops_with_step_ids_and_checkpoint() {
 fn gpu_backend_runs_the_default_scene_and_info_lists_adapters() {
     let (code, out, err) = talus(&["info"]);
     assert_eq!(code, 0, "{err}");
-    assert!(out.contains("GPU adapters (Vulkan)") && out.contains("--backend auto"), "{out}");
+    assert!(
+        out.contains("GPU adapters (Vulkan)") && out.contains("--backend auto"),
+        "{out}"
+    );
     let has_gpu = !out.contains("none found");
     let dir = tmp("gpu");
     let (code, _, err) = talus(&[
-        "run", "--backend", "gpu", "-q", "--out", dir.to_str().unwrap(),
-        "--set", "stop.time=2", "--set", "output.snapshot_every=1",
+        "run",
+        "--backend",
+        "gpu",
+        "-q",
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        "stop.time=2",
+        "--set",
+        "output.snapshot_every=1",
     ]);
     if !has_gpu {
-        assert!(!talus::gpu::device::gpu_required(), "TALUS_REQUIRE_GPU=1 but no adapter");
+        assert!(
+            !talus::gpu::device::gpu_required(),
+            "TALUS_REQUIRE_GPU=1 but no adapter"
+        );
         eprintln!("SKIPPED gpu run: no adapter");
         assert_eq!(code, 1);
         assert!(err.contains("no GPU adapter found"), "{err}");
@@ -179,7 +193,10 @@ fn gpu_backend_runs_the_default_scene_and_info_lists_adapters() {
     assert_eq!(code, 0, "{err}");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    assert!(summary["backend"].as_str().unwrap().starts_with("gpu"), "{summary}");
+    assert!(
+        summary["backend"].as_str().unwrap().starts_with("gpu"),
+        "{summary}"
+    );
     assert_eq!(summary["steps"], 1000);
     assert!(dir.join("snapshots/snap_0000000500.json").exists());
 }

@@ -23,9 +23,9 @@ fn small_heap(extra: &[&str]) -> talus::scene::Scene {
     scene::parse(scene::DEFAULT_SCENE, &o).expect("valid scene")
 }
 
-fn run_to(dir: &Path, sim: &mut Simulation) {
+fn run_to(dir: &Path, sim: Simulation) {
     run(
-        sim,
+        &mut talus::run::Engine::cpu(sim),
         &RunOptions {
             out: dir.to_path_buf(),
             quiet: true,
@@ -75,15 +75,15 @@ fn assert_same_snapshot(a: &Path, b: &Path) {
 fn same_seed_gives_bitwise_identical_snapshots() {
     let tmp = std::env::temp_dir().join(format!("talus-det-{}", std::process::id()));
     let (a, b, c) = (tmp.join("a"), tmp.join("b"), tmp.join("c"));
-    run_to(&a, &mut Simulation::new(small_heap(&[])).unwrap());
-    run_to(&b, &mut Simulation::new(small_heap(&[])).unwrap());
+    run_to(&a, Simulation::new(small_heap(&[])).unwrap());
+    run_to(&b, Simulation::new(small_heap(&[])).unwrap());
     for step in [3750, 7500, 11250, 15000] {
         let name = format!("snapshots/snap_{step:010}.json");
         assert_same_snapshot(&a.join(&name), &b.join(&name));
     }
     assert_same_snapshot(&a.join("final.json"), &b.join("final.json"));
     // A different seed must give a different heap (the test can fail).
-    run_to(&c, &mut Simulation::new(small_heap(&["seed=2"])).unwrap());
+    run_to(&c, Simulation::new(small_heap(&["seed=2"])).unwrap());
     let (fa, fc) = (
         snapshot::read(&a.join("final.json")).unwrap(),
         snapshot::read(&c.join("final.json")).unwrap(),
@@ -96,16 +96,16 @@ fn same_seed_gives_bitwise_identical_snapshots() {
 fn resume_from_checkpoint_is_bitwise_identical() {
     let tmp = std::env::temp_dir().join(format!("talus-resume-{}", std::process::id()));
     let (full, resumed) = (tmp.join("full"), tmp.join("resumed"));
-    run_to(&full, &mut Simulation::new(small_heap(&[])).unwrap());
+    run_to(&full, Simulation::new(small_heap(&[])).unwrap());
     // checkpoint at t = 15 (step 7500), with the heap still forming
     let ckpt = full.join("checkpoints/ckpt_0000007500.bin");
-    let mut sim = talus::checkpoint::read(&ckpt, &[]).expect("checkpoint loads");
+    let sim = talus::checkpoint::read(&ckpt, &[]).expect("checkpoint loads");
     assert_eq!(sim.step, 7500);
     assert!(
         !sim.springs.is_empty(),
         "the checkpoint carries tangential springs"
     );
-    run_to(&resumed, &mut sim);
+    run_to(&resumed, sim);
     assert_same_snapshot(
         &full.join("snapshots/snap_0000011250.json"),
         &resumed.join("snapshots/snap_0000011250.json"),
@@ -119,7 +119,7 @@ fn damaged_checkpoint_is_an_error_not_a_panic() {
     let tmp = std::env::temp_dir().join(format!("talus-bad-ckpt-{}", std::process::id()));
     run_to(
         &tmp,
-        &mut Simulation::new(small_heap(&["stop.time=2", "output.checkpoint_every=2"])).unwrap(),
+        Simulation::new(small_heap(&["stop.time=2", "output.checkpoint_every=2"])).unwrap(),
     );
     let ckpt = tmp.join("checkpoints/ckpt_0000001000.bin");
     let bytes = std::fs::read(&ckpt).unwrap();

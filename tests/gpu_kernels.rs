@@ -32,7 +32,10 @@ fn random_scene(n: usize, law: serde_json::Value, seed: u64) -> serde_json::Valu
         })
         .collect();
     let w = cols as f64 + 1.5;
-    let mut v = common::scene_value(law, json!([{ "kind": "list", "material": "m", "particles": list }]));
+    let mut v = common::scene_value(
+        law,
+        json!([{ "kind": "list", "material": "m", "particles": list }]),
+    );
     v["dt"] = json!(2e-4);
     v["gravity"] = json!({ "g": [0.0, -1.0] });
     v["domain"] = json!({ "x": [-3.0, w + 3.0], "z": [-3.0, w + 3.0] });
@@ -73,7 +76,10 @@ fn gpu_pairs(g: &mut GpuSimulation) -> Vec<Pair> {
     let mut pairs = Vec::new();
     for i in 0..n {
         for k in 0..count[i] as usize {
-            pairs.push(Pair { i: i as u32, j: js[i * MAX_CONTACTS as usize + k] });
+            pairs.push(Pair {
+                i: i as u32,
+                j: js[i * MAX_CONTACTS as usize + k],
+            });
         }
     }
     pairs
@@ -81,7 +87,10 @@ fn gpu_pairs(g: &mut GpuSimulation) -> Vec<Pair> {
 
 #[test]
 fn cell_list_matches_the_cpu() {
-    let Some(mut g) = setup("cell_list_matches_the_cpu", &random_scene(500, spring_dashpot(), 1)) else {
+    let Some(mut g) = setup(
+        "cell_list_matches_the_cpu",
+        &random_scene(500, spring_dashpot(), 1),
+    ) else {
         return;
     };
     g.run_kernels(&GpuSimulation::CELL_LIST);
@@ -91,13 +100,24 @@ fn cell_list_matches_the_cpu() {
     cpu.build(&grid, &host.particles.q[0], &host.particles.active);
     let n = host.particles.len();
     let cells = grid.cell_count();
-    assert_eq!(g.read_u32("cell_of", n), cpu.cell_of, "cell of each particle");
+    assert_eq!(
+        g.read_u32("cell_of", n),
+        cpu.cell_of,
+        "cell of each particle"
+    );
     assert_eq!(g.read_u32("cell_count", cells), cpu.count, "histogram");
-    assert_eq!(g.read_u32("cell_start", cells), cpu.start, "exclusive prefix sum");
+    assert_eq!(
+        g.read_u32("cell_start", cells),
+        cpu.start,
+        "exclusive prefix sum"
+    );
     // Within a cell the GPU order comes from atomics; as sets the cells must agree.
     let mut sorted = g.read_u32("sorted", n);
     for c in 0..cells {
-        let (a, b) = (cpu.start[c] as usize, (cpu.start[c] + cpu.count[c]) as usize);
+        let (a, b) = (
+            cpu.start[c] as usize,
+            (cpu.start[c] + cpu.count[c]) as usize,
+        );
         sorted[a..b].sort_unstable();
     }
     assert_eq!(sorted, cpu.sorted, "scatter");
@@ -130,7 +150,10 @@ fn prefix_sum_matches_the_cpu_on_all_three_levels() {
 
 #[test]
 fn find_contacts_matches_the_cpu_for_both_laws() {
-    for (name, law) in [("spring_dashpot", spring_dashpot()), ("continuous", continuous())] {
+    for (name, law) in [
+        ("spring_dashpot", spring_dashpot()),
+        ("continuous", continuous()),
+    ] {
         let Some(mut g) = setup("find_contacts_matches_the_cpu", &random_scene(600, law, 3)) else {
             return;
         };
@@ -140,8 +163,19 @@ fn find_contacts_matches_the_cpu_for_both_laws() {
         let mut cells = CellList::default();
         cells.build(&grid, &host.particles.q[0], &host.particles.active);
         let mut cpu = Vec::new();
-        find_contacts(&grid, &cells, &host.particles, &host.walls, host.law.range_factor(), &mut cpu);
-        assert!(cpu.len() > 500, "{name}: a dense packing ({} contacts)", cpu.len());
+        find_contacts(
+            &grid,
+            &cells,
+            &host.particles,
+            &host.walls,
+            host.law.range_factor(),
+            &mut cpu,
+        );
+        assert!(
+            cpu.len() > 500,
+            "{name}: a dense packing ({} contacts)",
+            cpu.len()
+        );
         assert_eq!(pairs, cpu, "{name}: same contacts in the same order");
     }
 }
@@ -156,7 +190,10 @@ fn contact_forces_and_reduction_match_the_cpu() {
     // f32 against f64: geometry carries ~1e-7 of a diameter, and the overlaps here are
     // 1e-2..1e-1 of a diameter, so forces agree to ~1e-5 of the largest contact force;
     // 1e-4 leaves room for the velocity terms and the 6-10 term sums.
-    for (name, law) in [("spring_dashpot", spring_dashpot()), ("continuous", continuous())] {
+    for (name, law) in [
+        ("spring_dashpot", spring_dashpot()),
+        ("continuous", continuous()),
+    ] {
         let Some(mut g) = setup("contact_forces_match_the_cpu", &random_scene(400, law, 4)) else {
             return;
         };
@@ -165,10 +202,19 @@ fn contact_forces_and_reduction_match_the_cpu() {
         let mut rng = Rng::new(9);
         let entries: Vec<Entry> = pairs
             .iter()
-            .map(|p| Entry { i: p.i, j: p.j, value: rng.range(-2e-3, 2e-3) as f32, _pad: 0 })
+            .map(|p| Entry {
+                i: p.i,
+                j: p.j,
+                value: rng.range(-2e-3, 2e-3) as f32,
+                _pad: 0,
+            })
             .collect();
         g.upload_springs(&entries);
-        g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces, Kernel::ReduceForces]);
+        g.run_kernels(&[
+            Kernel::GatherHistory,
+            Kernel::ContactForces,
+            Kernel::ReduceForces,
+        ]);
         let host = g.download().clone();
         let history: Vec<f64> = entries.iter().map(|e| e.value as f64).collect();
         let n = host.particles.len();
@@ -177,12 +223,25 @@ fn contact_forces_and_reduction_match_the_cpu() {
         let mut k_global = 0;
         for i in 0..n {
             for k in 0..count[i] as usize {
-                assert_eq!(hist_in[i * MAX_CONTACTS as usize + k], entries[k_global].value, "{name}: gathered history");
+                assert_eq!(
+                    hist_in[i * MAX_CONTACTS as usize + k],
+                    entries[k_global].value,
+                    "{name}: gathered history"
+                );
                 k_global += 1;
             }
         }
         let (mut cpu, mut hist_out) = (Vec::new(), Vec::new());
-        contact_forces(&host.particles, &host.walls, &host.law, host.dt(), &pairs, &history, &mut cpu, &mut hist_out);
+        contact_forces(
+            &host.particles,
+            &host.walls,
+            &host.law,
+            host.dt(),
+            &pairs,
+            &history,
+            &mut cpu,
+            &mut hist_out,
+        );
         let scale = cpu.iter().map(|c| c.f_n.abs()).fold(0.0, f64::max);
         assert!(scale > 0.0);
         let out = g.read_contact_out(n * MAX_CONTACTS as usize);
@@ -199,12 +258,28 @@ fn contact_forces_and_reduction_match_the_cpu() {
                     .max(rel(o.ft[1] as f64, c.force[1], scale))
                     .max(rel(o.info[0] as f64, c.f_n, scale))
                     .max(rel(o.info[1] as f64, c.f_t, scale));
-                let dh = rel(gpu_hist[i * MAX_CONTACTS as usize + k] as f64, hist_out[k_global], hscale);
-                assert!(dh < 1e-4, "{name}: history of contact {k_global} {:?} differs by {dh:.2e}: gpu {} cpu {} (in {}), gpu out {:?} cpu {:?}", pairs[k_global], gpu_hist[i * MAX_CONTACTS as usize + k], hist_out[k_global], history[k_global], o, c);
+                let dh = rel(
+                    gpu_hist[i * MAX_CONTACTS as usize + k] as f64,
+                    hist_out[k_global],
+                    hscale,
+                );
+                assert!(
+                    dh < 1e-4,
+                    "{name}: history of contact {k_global} {:?} differs by {dh:.2e}: gpu {} cpu {} (in {}), gpu out {:?} cpu {:?}",
+                    pairs[k_global],
+                    gpu_hist[i * MAX_CONTACTS as usize + k],
+                    hist_out[k_global],
+                    history[k_global],
+                    o,
+                    c
+                );
                 k_global += 1;
             }
         }
-        assert!(worst < 1e-4, "{name}: forces differ by {worst:.2e} of the largest");
+        assert!(
+            worst < 1e-4,
+            "{name}: forces differ by {worst:.2e} of the largest"
+        );
         let mut f = Vec::new();
         reduce_forces(&host.particles, &pairs, &cpu, &mut f);
         let gf = g.read_forces(n);
@@ -213,7 +288,10 @@ fn contact_forces_and_reduction_match_the_cpu() {
             for d in 0..3 {
                 let s = if d == 2 { tscale } else { scale };
                 let e = rel(gf[i][d] as f64, f[i][d], s);
-                assert!(e < 1e-4, "{name}: reduced force {d} of particle {i} differs by {e:.2e}");
+                assert!(
+                    e < 1e-4,
+                    "{name}: reduced force {d} of particle {i} differs by {e:.2e}"
+                );
             }
         }
     }
@@ -224,8 +302,10 @@ fn spring_table_survives_contact_churn() {
     // 300 particles, random contact lists that persist (80 %), open and close each step;
     // the GPU table must give back exactly the value stored for every persisting pair
     // and 0 for every new one, never losing or duplicating a spring.
-    let Some(mut g) = setup("spring_table_survives_contact_churn", &random_scene(300, spring_dashpot(), 6))
-    else {
+    let Some(mut g) = setup(
+        "spring_table_survives_contact_churn",
+        &random_scene(300, spring_dashpot(), 6),
+    ) else {
         return;
     };
     let n = g.live() as usize;
@@ -242,7 +322,11 @@ fn spring_table_survives_contact_churn() {
         for _ in 0..200 {
             let i = (rng.uniform() * (n - 1) as f64) as usize;
             let j = (i + 1 + (rng.uniform() * 30.0) as usize).min(n - 1) as u32;
-            lists[i].push(if rng.uniform() < 0.1 { 0xFFFF_0000 + (rng.uniform() * 3.0) as u32 } else { j });
+            lists[i].push(if rng.uniform() < 0.1 {
+                0xFFFF_0000 + (rng.uniform() * 3.0) as u32
+            } else {
+                j
+            });
         }
         let (mut count, mut js, mut values) = (vec![0u32; n], vec![0u32; n * m], vec![0f32; n * m]);
         let mut next = BTreeMap::new();
@@ -271,7 +355,11 @@ fn spring_table_survives_contact_churn() {
         g.run_kernels(&[Kernel::ClearTable, Kernel::StoreHistory]);
         g.swap_springs();
         let stored = g.download().springs.len();
-        assert_eq!(stored, next.len(), "step {step}: no lost or duplicated springs");
+        assert_eq!(
+            stored,
+            next.len(),
+            "step {step}: no lost or duplicated springs"
+        );
         reference = next;
     }
 }
@@ -292,15 +380,28 @@ fn one_step_of_each_integrator_matches_the_cpu() {
         g.advance(1).expect("no divergence");
         cpu.step().expect("no divergence");
         let host = g.download();
-        let q1_scale = cpu.particles.q[1].iter().map(|q| q[0].abs().max(q[1].abs())).fold(0.0, f64::max);
+        let q1_scale = cpu.particles.q[1]
+            .iter()
+            .map(|q| q[0].abs().max(q[1].abs()))
+            .fold(0.0, f64::max);
         for i in 0..cpu.particles.len() {
             let (a, b) = (host.particles.q[0][i], cpu.particles.q[0][i]);
             for d in 0..3 {
-                assert!((a[d] - b[d]).abs() < 1e-6, "{integrator}: q0[{d}] of {i}: {} vs {}", a[d], b[d]);
+                assert!(
+                    (a[d] - b[d]).abs() < 1e-6,
+                    "{integrator}: q0[{d}] of {i}: {} vs {}",
+                    a[d],
+                    b[d]
+                );
             }
             let (a, b) = (host.particles.q[1][i], cpu.particles.q[1][i]);
             for d in 0..2 {
-                assert!(rel(a[d], b[d], q1_scale) < 1e-3, "{integrator}: q1[{d}] of {i}: {} vs {}", a[d], b[d]);
+                assert!(
+                    rel(a[d], b[d], q1_scale) < 1e-3,
+                    "{integrator}: q1[{d}] of {i}: {} vs {}",
+                    a[d],
+                    b[d]
+                );
             }
         }
     }

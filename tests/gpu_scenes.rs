@@ -8,7 +8,9 @@ use talus::gpu::GpuSimulation;
 use talus::sim::Simulation;
 
 fn scene_file(name: &str, overrides: &[&str]) -> talus::scene::Scene {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(name);
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
     let o: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
     talus::scene::load(&path, &o).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
@@ -18,7 +20,11 @@ fn scene_file(name: &str, overrides: &[&str]) -> talus::scene::Scene {
 fn quick_pour() -> talus::scene::Scene {
     scene_file(
         "r4_pour_reduced.json",
-        &["particles[1].position=[0, 8]", "particles[1].rate=4", "particles[1].count=60"],
+        &[
+            "particles[1].position=[0, 8]",
+            "particles[1].rate=4",
+            "particles[1].count=60",
+        ],
     )
 }
 
@@ -67,7 +73,9 @@ fn stats(s: &Simulation) -> Stats {
 
 #[test]
 fn r4_pour_agrees_with_the_cpu_then_statistically() {
-    let Some(mut g) = gpu_sim("r4_pour_agrees_with_the_cpu", quick_pour()) else { return };
+    let Some(mut g) = gpu_sim("r4_pour_agrees_with_the_cpu", quick_pour()) else {
+        return;
+    };
     let mut cpu = Simulation::new(quick_pour()).unwrap();
     // Until the first collisions (free flight and the first impacts, t = 1.5) the
     // trajectories agree to f32 accuracy: 1e-4 of a diameter.
@@ -75,8 +83,15 @@ fn r4_pour_agrees_with_the_cpu_then_statistically() {
     g.advance(early).unwrap();
     (0..early).for_each(|_| cpu.step().unwrap());
     let d = max_position_difference(g.download(), &cpu, 1.0);
-    assert!(d < 1e-4, "after {early} steps positions differ by {d:.2e} d");
-    assert_eq!(g.download().particles.len(), cpu.particles.len(), "same insertions");
+    assert!(
+        d < 1e-4,
+        "after {early} steps positions differ by {d:.2e} d"
+    );
+    assert_eq!(
+        g.download().particles.len(),
+        cpu.particles.len(),
+        "same insertions"
+    );
     // Then collisions amplify the rounding differences (chaos); after t = 18 the pile
     // has formed and the two runs agree in their statistics only.
     let late = 18_000 - early;
@@ -85,12 +100,27 @@ fn r4_pour_agrees_with_the_cpu_then_statistically() {
     let (a, b) = (stats(g.download()), stats(&cpu));
     eprintln!(
         "GPU: {} particles, CoM ({:.4}, {:.4}), KE {:.4e}, {} contacts\nCPU: {} particles, CoM ({:.4}, {:.4}), KE {:.4e}, {} contacts",
-        a.particles, a.com[0], a.com[1], a.kinetic, a.contacts, b.particles, b.com[0], b.com[1], b.kinetic, b.contacts
+        a.particles,
+        a.com[0],
+        a.com[1],
+        a.kinetic,
+        a.contacts,
+        b.particles,
+        b.com[0],
+        b.com[1],
+        b.kinetic,
+        b.contacts
     );
     assert_eq!(a.particles, b.particles);
     assert!((a.com[0] - b.com[0]).abs() < 0.5, "centre of mass x");
-    assert!((a.com[1] - b.com[1]).abs() < 0.1 * b.com[1], "centre of mass height");
-    assert!((a.contacts as f64 - b.contacts as f64).abs() < 0.15 * b.contacts as f64, "contact count");
+    assert!(
+        (a.com[1] - b.com[1]).abs() < 0.1 * b.com[1],
+        "centre of mass height"
+    );
+    assert!(
+        (a.contacts as f64 - b.contacts as f64).abs() < 0.15 * b.contacts as f64,
+        "contact count"
+    );
     let ke_ref = a.kinetic.max(b.kinetic);
     assert!(ke_ref > 0.0);
 }
@@ -104,7 +134,9 @@ fn lattice_pile_agrees_with_the_cpu() {
     // k_n = 1e5 gives ~3e-4 d, the regime the GPU path is built for.
     let scene = scene_file("r1_pile_reduced.json", &["contact.k_n=1e5"]);
     let d = 1.5e-3;
-    let Some(mut g) = gpu_sim("lattice_pile_agrees_with_the_cpu", scene.clone()) else { return };
+    let Some(mut g) = gpu_sim("lattice_pile_agrees_with_the_cpu", scene.clone()) else {
+        return;
+    };
     let mut cpu = Simulation::new(scene).unwrap();
     let steps = 10_000; // t = 0.02 s, gravity at 20 %
     g.advance(steps).unwrap();
@@ -118,7 +150,11 @@ fn lattice_pile_agrees_with_the_cpu() {
     // is "in contact" is decided by rounding; compare forces pair by pair over the union
     // of both contact lists, a missing contact counting as zero force.
     let forces = |s: &Simulation| -> std::collections::BTreeMap<(u32, u32), f64> {
-        s.pairs.iter().zip(&s.contacts).map(|(p, c)| ((p.i, p.j), c.f_n)).collect()
+        s.pairs
+            .iter()
+            .zip(&s.contacts)
+            .map(|(p, c)| ((p.i, p.j), c.f_n))
+            .collect()
     };
     let (fg, fc) = (forces(gs), forces(&cpu));
     let mean = fc.values().sum::<f64>() / fc.len() as f64;
@@ -130,10 +166,16 @@ fn lattice_pile_agrees_with_the_cpu() {
     // Position differences of ~1e-5 d against overlaps of ~1e-3 d: about 1e-2 of the
     // mean force (measured 6.4e-3).
     eprintln!("lattice pile: positions {dp:.2e} d, normal forces {worst:.2e} of the mean");
-    assert!(worst < 2e-2, "normal forces differ by {worst:.2e} of the mean");
+    assert!(
+        worst < 2e-2,
+        "normal forces differ by {worst:.2e} of the mean"
+    );
     let total = |s: &Simulation| s.contacts.iter().map(|c| c.force[1]).sum::<f64>();
     let (a, b) = (total(gs), total(&cpu));
-    assert!((a - b).abs() < 1e-3 * b.abs(), "vertical force sum {a} vs {b}");
+    assert!(
+        (a - b).abs() < 1e-3 * b.abs(),
+        "vertical force sum {a} vs {b}"
+    );
 }
 
 /// Two zig-zag columns of 12 disks between walls, one at x = 0 and one at x = 10^4 d,
@@ -165,7 +207,10 @@ fn columns_scene(offset: f64) -> serde_json::Value {
 fn overlaps_are_the_same_at_x_0_and_at_x_10000_diameters() {
     let offset = 1.0e4;
     let v = columns_scene(offset);
-    let Some(mut g) = gpu_sim("overlaps_are_the_same_at_x_0_and_at_x_10000", common::parse(&v)) else {
+    let Some(mut g) = gpu_sim(
+        "overlaps_are_the_same_at_x_0_and_at_x_10000",
+        common::parse(&v),
+    ) else {
         return;
     };
     let mut cpu = common::sim(&v);
@@ -185,7 +230,11 @@ fn overlaps_are_the_same_at_x_0_and_at_x_10000_diameters() {
     };
     let (a, b) = (overlaps(s, 0), overlaps(s, 12));
     assert_eq!(a.len(), b.len());
-    assert!(a.len() >= 20, "every disk rests on its neighbour and a wall: {}", a.len());
+    assert!(
+        a.len() >= 20,
+        "every disk rests on its neighbour and a wall: {}",
+        a.len()
+    );
     let mut worst: f64 = 0.0;
     for (x, y) in a.iter().zip(&b) {
         assert!(*x > 1e-4, "a resting overlap: {x}");
@@ -198,13 +247,21 @@ fn overlaps_are_the_same_at_x_0_and_at_x_10000_diameters() {
         worst_cpu = worst_cpu.max((x - y).abs() / y);
     }
     eprintln!("overlaps at x = 1e4 d vs x = 0: {worst:.2e}; GPU at 1e4 d vs CPU: {worst_cpu:.2e}");
-    assert!(worst < 1e-3, "overlaps at x = 1e4 d differ from x = 0 by {worst:.2e}");
-    assert!(worst_cpu < 1e-3, "GPU overlaps differ from the CPU's by {worst_cpu:.2e}");
+    assert!(
+        worst < 1e-3,
+        "overlaps at x = 1e4 d differ from x = 0 by {worst:.2e}"
+    );
+    assert!(
+        worst_cpu < 1e-3,
+        "GPU overlaps differ from the CPU's by {worst_cpu:.2e}"
+    );
 }
 
 #[test]
 fn gpu_runs_are_bitwise_reproducible_and_resume_bitwise() {
-    let Some(mut a) = gpu_sim("gpu_runs_are_bitwise_reproducible", quick_pour()) else { return };
+    let Some(mut a) = gpu_sim("gpu_runs_are_bitwise_reproducible", quick_pour()) else {
+        return;
+    };
     let mut b = gpu_sim("gpu_runs_are_bitwise_reproducible", quick_pour()).unwrap();
     let steps = 6000;
     a.advance(steps).unwrap();
@@ -215,13 +272,23 @@ fn gpu_runs_are_bitwise_reproducible_and_resume_bitwise() {
     let path = dir.join("ckpt.bin");
     talus::checkpoint::write(b.download(), &path).unwrap();
     let loaded = talus::checkpoint::read(&path, &[]).unwrap();
-    assert!(loaded.device_state.is_some(), "a GPU checkpoint carries the device state");
+    assert!(
+        loaded.device_state.is_some(),
+        "a GPU checkpoint carries the device state"
+    );
     let gpu = common::gpu("resume").unwrap();
     let mut b = GpuSimulation::with_gpu(loaded, gpu).unwrap();
     b.advance(steps - steps / 2).unwrap();
     let (sa, sb) = (a.device_state(), b.device_state());
-    assert!(sa.states.len() > 30, "particles were poured: {}", sa.states.len());
-    assert!(sa == sb, "resumed GPU run differs from the uninterrupted one");
+    assert!(
+        sa.states.len() > 30,
+        "particles were poured: {}",
+        sa.states.len()
+    );
+    assert!(
+        sa == sb,
+        "resumed GPU run differs from the uninterrupted one"
+    );
     // And a third, uninterrupted run is the same bit for bit.
     let mut c = gpu_sim("gpu_runs_are_bitwise_reproducible", quick_pour()).unwrap();
     c.advance(steps).unwrap();

@@ -13,18 +13,37 @@ const GEOMETRY: &str = include_str!("../../shaders/geometry.wgsl");
 const LAWS: &str = include_str!("../../shaders/laws.wgsl");
 
 pub const MODULES: &[ModuleSource] = &[
-    ModuleSource { name: "insert", parts: &[COMMON, include_str!("../../shaders/insert.wgsl")] },
-    ModuleSource { name: "predict", parts: &[COMMON, include_str!("../../shaders/predict.wgsl")] },
-    ModuleSource { name: "cell_index", parts: &[COMMON, include_str!("../../shaders/cell_index.wgsl")] },
+    ModuleSource {
+        name: "insert",
+        parts: &[COMMON, include_str!("../../shaders/insert.wgsl")],
+    },
+    ModuleSource {
+        name: "predict",
+        parts: &[COMMON, include_str!("../../shaders/predict.wgsl")],
+    },
+    ModuleSource {
+        name: "cell_index",
+        parts: &[COMMON, include_str!("../../shaders/cell_index.wgsl")],
+    },
     ModuleSource {
         name: "cell_histogram",
         parts: &[COMMON, include_str!("../../shaders/cell_histogram.wgsl")],
     },
-    ModuleSource { name: "prefix_sum", parts: &[COMMON, include_str!("../../shaders/prefix_sum.wgsl")] },
-    ModuleSource { name: "scatter", parts: &[COMMON, include_str!("../../shaders/scatter.wgsl")] },
+    ModuleSource {
+        name: "prefix_sum",
+        parts: &[COMMON, include_str!("../../shaders/prefix_sum.wgsl")],
+    },
+    ModuleSource {
+        name: "scatter",
+        parts: &[COMMON, include_str!("../../shaders/scatter.wgsl")],
+    },
     ModuleSource {
         name: "find_contacts",
-        parts: &[COMMON, GEOMETRY, include_str!("../../shaders/find_contacts.wgsl")],
+        parts: &[
+            COMMON,
+            GEOMETRY,
+            include_str!("../../shaders/find_contacts.wgsl"),
+        ],
     },
     ModuleSource {
         name: "gather_history",
@@ -32,7 +51,12 @@ pub const MODULES: &[ModuleSource] = &[
     },
     ModuleSource {
         name: "contact_forces",
-        parts: &[COMMON, GEOMETRY, LAWS, include_str!("../../shaders/contact_forces.wgsl")],
+        parts: &[
+            COMMON,
+            GEOMETRY,
+            LAWS,
+            include_str!("../../shaders/contact_forces.wgsl"),
+        ],
     },
     ModuleSource {
         name: "store_history",
@@ -42,9 +66,18 @@ pub const MODULES: &[ModuleSource] = &[
         name: "reduce_forces",
         parts: &[COMMON, include_str!("../../shaders/reduce_forces.wgsl")],
     },
-    ModuleSource { name: "correct", parts: &[COMMON, include_str!("../../shaders/correct.wgsl")] },
-    ModuleSource { name: "kick_drift", parts: &[COMMON, include_str!("../../shaders/kick_drift.wgsl")] },
-    ModuleSource { name: "boundaries", parts: &[COMMON, include_str!("../../shaders/boundaries.wgsl")] },
+    ModuleSource {
+        name: "correct",
+        parts: &[COMMON, include_str!("../../shaders/correct.wgsl")],
+    },
+    ModuleSource {
+        name: "kick_drift",
+        parts: &[COMMON, include_str!("../../shaders/kick_drift.wgsl")],
+    },
+    ModuleSource {
+        name: "boundaries",
+        parts: &[COMMON, include_str!("../../shaders/boundaries.wgsl")],
+    },
 ];
 
 impl ModuleSource {

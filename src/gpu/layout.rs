@@ -155,22 +155,73 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
         };
     }
     vec![
-        fields!(Params, "Params", [
-            n_cap, nx, nz, cells, n_walls, n_sources, table_mask, integrator, cell_size,
-            dt, max_overlap, range_factor, gx, gz, ramp_steps, law, dom_lo_x, dom_lo_z,
-            dom_hi_x, dom_hi_z, k_n, nu, psi, delta0, gamma_n, k_t, gamma_t, mu, clamp,
-            elastic, n_exp, hooke_k, r0, alpha, damping_fraction, g_scale, scan_blocks1,
-            scan_blocks2, scan_offset2, _pad
-        ]),
+        fields!(
+            Params,
+            "Params",
+            [
+                n_cap,
+                nx,
+                nz,
+                cells,
+                n_walls,
+                n_sources,
+                table_mask,
+                integrator,
+                cell_size,
+                dt,
+                max_overlap,
+                range_factor,
+                gx,
+                gz,
+                ramp_steps,
+                law,
+                dom_lo_x,
+                dom_lo_z,
+                dom_hi_x,
+                dom_hi_z,
+                k_n,
+                nu,
+                psi,
+                delta0,
+                gamma_n,
+                k_t,
+                gamma_t,
+                mu,
+                clamp,
+                elastic,
+                n_exp,
+                hooke_k,
+                r0,
+                alpha,
+                damping_fraction,
+                g_scale,
+                scan_blocks1,
+                scan_blocks2,
+                scan_offset2,
+                _pad
+            ]
+        ),
         fields!(State, "State", [q, anchor, _pad]),
         fields!(Props, "Props", [radius, mass, inv_inertia, flags]),
         fields!(ContactOut, "ContactOut", [ft, info]),
         fields!(Wall, "Wall", [anchor, frac, ab, _pad]),
         fields!(Entry, "Entry", [i, j, value, _pad]),
         fields!(Source, "Source", [first, count, inserted, _pad]),
-        fields!(Candidate, "Candidate", [
-            anchor, frac, velocity, radius, mass, inv_inertia, due_step, flags, _pad
-        ]),
+        fields!(
+            Candidate,
+            "Candidate",
+            [
+                anchor,
+                frac,
+                velocity,
+                radius,
+                mass,
+                inv_inertia,
+                due_step,
+                flags,
+                _pad
+            ]
+        ),
     ]
 }
 

@@ -181,7 +181,10 @@ impl GpuSimulation {
                 candidates.push(Candidate {
                     anchor,
                     frac,
-                    velocity: [(spec.velocity[0] * dt) as f32, (spec.velocity[1] * dt) as f32],
+                    velocity: [
+                        (spec.velocity[0] * dt) as f32,
+                        (spec.velocity[1] * dt) as f32,
+                    ],
                     radius: one.radius[0] as f32,
                     mass: one.mass[0] as f32,
                     inv_inertia: (1.0 / one.inertia[0]) as f32,
@@ -280,7 +283,8 @@ impl GpuSimulation {
             })
             .collect();
 
-        let mut control = vec![0u32; control::BLOCKED + (sources.len() * INSERT_WINDOW as usize).max(1)];
+        let mut control =
+            vec![0u32; control::BLOCKED + (sources.len() * INSERT_WINDOW as usize).max(1)];
         control[control::STEP] = sim.step as u32;
         control[control::LIVE] = n_now;
         control[control::HALT_STEP] = u32::MAX;
@@ -513,7 +517,14 @@ impl GpuSimulation {
         ] {
             self.encode_kernel(pass, k);
         }
-        self.encode_kernel(pass, if gear { Kernel::Correct } else { Kernel::KickDrift });
+        self.encode_kernel(
+            pass,
+            if gear {
+                Kernel::Correct
+            } else {
+                Kernel::KickDrift
+            },
+        );
         self.encode_kernel(pass, Kernel::Boundaries);
         self.encode_kernel(pass, Kernel::AdvanceClock);
     }
@@ -573,7 +584,11 @@ impl GpuSimulation {
                     continue;
                 }
                 let ri = self.sim.particles.radius[p.i as usize];
-                let rmin = if p.is_wall() { ri } else { ri.min(self.sim.particles.radius[p.j as usize]) };
+                let rmin = if p.is_wall() {
+                    ri
+                } else {
+                    ri.min(self.sim.particles.radius[p.j as usize])
+                };
                 let ratio = cf.overlap / rmin;
                 if worst.is_none_or(|(_, r)| ratio > r) {
                     worst = Some((p.j, ratio));
@@ -585,13 +600,24 @@ impl GpuSimulation {
             } else {
                 j.to_string()
             };
-            return Divergence::Overlap { i: id, j, ratio, limit };
+            return Divergence::Overlap {
+                i: id,
+                j,
+                ratio,
+                limit,
+            };
         }
         if flags & control::HALT_NOT_FINITE != 0 {
-            return Divergence::NotFinite { id, what: "force or position" };
+            return Divergence::NotFinite {
+                id,
+                what: "force or position",
+            };
         }
         if flags & control::HALT_CONTACTS_FULL != 0 {
-            return Divergence::TooManyContacts { id, max: MAX_CONTACTS };
+            return Divergence::TooManyContacts {
+                id,
+                max: MAX_CONTACTS,
+            };
         }
         Divergence::SpringTableFull { id }
     }
@@ -602,7 +628,12 @@ impl GpuSimulation {
     }
 
     /// Copies `count` elements of type T from a buffer (blocking).
-    fn read_buffer<T: bytemuck::Pod>(&self, buf: &wgpu::Buffer, first: usize, count: usize) -> Vec<T> {
+    fn read_buffer<T: bytemuck::Pod>(
+        &self,
+        buf: &wgpu::Buffer,
+        first: usize,
+        count: usize,
+    ) -> Vec<T> {
         let size = size_of::<T>() as u64;
         let bytes = (count as u64 * size).next_multiple_of(4);
         if bytes == 0 {
@@ -631,7 +662,9 @@ impl GpuSimulation {
     }
 
     fn write_buffer<T: bytemuck::Pod>(&mut self, buf: &wgpu::Buffer, data: &[T]) {
-        self.gpu.queue.write_buffer(buf, 0, bytemuck::cast_slice(data));
+        self.gpu
+            .queue
+            .write_buffer(buf, 0, bytemuck::cast_slice(data));
         self.synced = false;
     }
 
@@ -676,9 +709,18 @@ impl GpuSimulation {
                 let o = outs[i * m + k];
                 let pi = parts.position(i);
                 let g = if j >= WALL_BASE {
-                    disk_wall(pi, parts.radius[i], &self.sim.walls[(j - WALL_BASE) as usize])
+                    disk_wall(
+                        pi,
+                        parts.radius[i],
+                        &self.sim.walls[(j - WALL_BASE) as usize],
+                    )
                 } else {
-                    disk_disk(pi, parts.radius[i], parts.position(j as usize), parts.radius[j as usize])
+                    disk_disk(
+                        pi,
+                        parts.radius[i],
+                        parts.position(j as usize),
+                        parts.radius[j as usize],
+                    )
                 };
                 pairs.push(Pair { i: i as u32, j });
                 contacts.push(ContactForce {
@@ -708,7 +750,11 @@ impl GpuSimulation {
         let table: Vec<Entry> = self.read_buffer(&self.buffers.tables[self.parity], 0, cap);
         let mut springs: Vec<Entry> = table.into_iter().filter(|e| e.i != EMPTY).collect();
         springs.sort_by_key(|e| (e.i, e.j));
-        DeviceState { states, props, springs }
+        DeviceState {
+            states,
+            props,
+            springs,
+        }
     }
 
     // ---- access for tests of single kernels ----
@@ -825,7 +871,8 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
             s.q[k] = [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
         }
         states.push(s);
-        let flags = (p.active[i] as u32) * ACTIVE | (p.fixed[i] as u32) * FIXED | (p.material[i] << 8);
+        let flags =
+            ((p.active[i] as u32) * ACTIVE) | ((p.fixed[i] as u32) * FIXED) | (p.material[i] << 8);
         props.push(Props {
             radius: p.radius[i] as f32,
             mass: p.mass[i] as f32,
@@ -837,12 +884,7 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
 }
 
 /// Device layout → host f64 particles.
-pub fn from_device(
-    states: &[State],
-    props: &[Props],
-    origin: [f64; 2],
-    cell: f32,
-) -> Particles {
+pub fn from_device(states: &[State], props: &[Props], origin: [f64; 2], cell: f32) -> Particles {
     let l = cell as f64;
     let mut p = Particles::default();
     for (s, pr) in states.iter().zip(props) {
@@ -857,7 +899,11 @@ pub fn from_device(
         }
         p.radius.push(pr.radius as f64);
         p.mass.push(pr.mass as f64);
-        p.inertia.push(if pr.inv_inertia == 0.0 { f64::INFINITY } else { 1.0 / pr.inv_inertia as f64 });
+        p.inertia.push(if pr.inv_inertia == 0.0 {
+            f64::INFINITY
+        } else {
+            1.0 / pr.inv_inertia as f64
+        });
         p.fixed.push(pr.flags & FIXED != 0);
         p.active.push(pr.flags & ACTIVE != 0);
         p.material.push(pr.flags >> 8);
