@@ -7,7 +7,7 @@ fn boundaries(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= live() || halted() || !is_active(i)) { return; }
     let s = state[i];
-    let p = vec2<f32>(s.anchor) * params.cell_size + s.q[0].xy;
+    let p = position(s);
     let ok = abs(s.q[0].x) <= 3.0e38 && abs(s.q[0].y) <= 3.0e38 && abs(s.q[0].z) <= 3.0e38;
     if (!ok) { halt(HALT_NOT_FINITE, i); return; }
     if (p.x < params.dom_lo_x || p.x > params.dom_hi_x || p.y < params.dom_lo_z || p.y > params.dom_hi_z) {

@@ -2,12 +2,8 @@
 // bindings. The Rust twins of these structs are in src/gpu/layout.rs; a test checks the
 // sizes and field offsets against naga's view of this file.
 //
-// Precision (SPEC 3, issue 3): a position is an integer cell `anchor` plus an f32
-// offset `frac` in [0, cell_size). The vector between two particles is
-// (anchor_i - anchor_j) * cell_size + (frac_i - frac_j): the integer difference of
-// neighbours is small and exact, the offsets are both below one cell, so the result
-// carries f32's relative precision (6e-8 of a diameter) wherever the pair sits in the
-// domain. Absolute f32 positions would lose 1e-3 of a diameter at 10^4 diameters.
+// Positions are fixed point (cell anchor + units + f32 remainder) for SPEC 3's
+// precision; see position.wgsl, which every module includes after this file.
 
 const WG: u32 = 64u;
 // Contacts per particle as the lower id (its own list) and as the higher id.
@@ -76,14 +72,18 @@ struct Params {
     scan_blocks1: u32,
     scan_blocks2: u32,
     scan_offset2: u32,
+    // fixed-point positions (position.wgsl): unit = cell_size / 2^30, and its inverse
+    unit: f32,
+    inv_unit: f32,
     _pad: u32,
 };
 
-// Dynamic state: q[0] = (frac_x, frac_z, theta, 0), q[k] = (dt^k/k!) d^k/dt^k.
+// Dynamic state: q[0] = (rem_x, rem_z, theta, 0) with the position's remainder in
+// units (position.wgsl), q[k] = (dt^k/k!) d^k/dt^k in length units.
 struct State {
     q: array<vec4<f32>, 6>,
     anchor: vec2<i32>,
-    _pad: vec2<u32>,
+    frac: vec2<u32>,
 };
 
 struct Props {
@@ -91,6 +91,9 @@ struct Props {
     mass: f32,
     inv_inertia: f32,   // 0 for fixed rotation
     flags: u32,         // ACTIVE | FIXED | material << 8
+    radius_units: u32,  // the radius in fixed point (position.wgsl)
+    radius_rem: f32,
+    _pad: vec2<u32>,
 };
 
 struct ContactOut {
@@ -100,9 +103,14 @@ struct ContactOut {
     info: vec4<f32>,
 };
 
+// A segment a-b; both end points in fixed point, ab = b - a in length units.
 struct Wall {
-    anchor: vec2<i32>,
-    frac: vec2<f32>,
+    a_anchor: vec2<i32>,
+    a_frac: vec2<u32>,
+    a_rem: vec2<f32>,
+    b_anchor: vec2<i32>,
+    b_frac: vec2<u32>,
+    b_rem: vec2<f32>,
     ab: vec2<f32>,
     _pad: vec2<f32>,
 };
@@ -123,13 +131,16 @@ struct Source {
 
 struct Candidate {
     anchor: vec2<i32>,
-    frac: vec2<f32>,
+    frac: vec2<u32>,
+    rem: vec2<f32>,
     velocity: vec2<f32>,  // scaled: dt * v
     radius: f32,
     mass: f32,
     inv_inertia: f32,
     due_step: u32,
     flags: u32,
+    radius_units: u32,
+    radius_rem: f32,
     _pad: u32,
 };
 
@@ -184,32 +195,6 @@ fn halt(reason: u32, id: u32) {
     atomicOr(&control[C_HALT], reason);
     atomicMin(&control[C_HALT_STEP], atomicLoad(&control[C_STEP]));
     atomicMin(&control[C_HALT_ID], id);
-}
-
-// Vector from point (aj, fj) to point (ai, fi), exact up to one f32 rounding of the
-// result (see the precision note at the top).
-fn rel(ai: vec2<i32>, fi: vec2<f32>, aj: vec2<i32>, fj: vec2<f32>) -> vec2<f32> {
-    return vec2<f32>(ai - aj) * params.cell_size + (fi - fj);
-}
-
-fn rel_ij(i: u32, j: u32) -> vec2<f32> {
-    return rel(state[i].anchor, state[i].q[0].xy, state[j].anchor, state[j].q[0].xy);
-}
-
-// Moves whole cells from the offset into the anchor so that 0 <= frac < cell_size.
-fn renormalize(s: ptr<function, State>) {
-    let l = params.cell_size;
-    for (var d = 0u; d < 2u; d++) {
-        var f = (*s).q[0][d];
-        var a = (*s).anchor[d];
-        let c = floor(f / l);
-        a += i32(c);
-        f -= c * l;
-        if (f >= l) { f -= l; a += 1; }
-        if (f < 0.0) { f += l; a -= 1; }
-        (*s).q[0][d] = f;
-        (*s).anchor[d] = a;
-    }
 }
 
 // Gravity at the given step (ramped linearly, paper 000 sec. 4).

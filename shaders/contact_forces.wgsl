@@ -25,10 +25,10 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         let wall = j >= WALL_BASE;
         if (wall) {
             let w = j - WALL_BASE;
-            g = disk_wall(wall_offset(i, w), ri, walls[w].ab);
+            g = disk_wall(i, w);
         } else {
-            d_ij = rel_ij(i, j);
-            g = disk_disk(d_ij, ri, props[j].radius);
+            d_ij = offset_vector(offset_ij(i, j));
+            g = disk_disk(i, j);
             v2 = velocity(j);
             rmin = min(ri, props[j].radius);
             let m2 = props[j].mass;

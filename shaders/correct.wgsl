@@ -10,7 +10,8 @@ fn acceleration(i: u32, g: vec2<f32>) -> vec4<f32> {
 fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
     let half_dt2 = 0.5 * params.dt * params.dt;
     let delta = half_dt2 * accel - (*s).q[2];
-    (*s).q[0] += (3.0 / 20.0) * delta;
+    (*s).q[0].z += (3.0 / 20.0) * delta.z;
+    displace(s, (3.0 / 20.0) * delta.xy);
     (*s).q[1] += (251.0 / 360.0) * delta;
     (*s).q[2] += delta;
     (*s).q[3] += (11.0 / 18.0) * delta;

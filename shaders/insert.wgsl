@@ -4,9 +4,11 @@
 // touch (parallel), then one thread places the due, free candidates in order. Nothing
 // is read back, so the queue never stalls.
 
-fn touches(a: vec2<i32>, f: vec2<f32>, r: f32, p: u32) -> bool {
-    let d = rel(a, f, state[p].anchor, state[p].q[0].xy);
-    let s = r + props[p].radius;
+fn touches(c: Candidate, p: u32) -> bool {
+    let o = offset(c.anchor, c.frac, c.rem, state[p].anchor, state[p].frac, state[p].q[0].xy);
+    if (!o.near) { return false; }
+    let d = offset_vector(o);
+    let s = c.radius + props[p].radius;
     return dot(d, d) < s * s;
 }
 
@@ -22,7 +24,7 @@ fn insert_check(@builtin(global_invocation_id) gid: vec3<u32>) {
             if (k >= src.count) { break; }
             let cand = candidates[src.first + k];
             if (cand.due_step > step) { break; }
-            if (touches(cand.anchor, cand.frac, cand.radius, p)) {
+            if (touches(cand, p)) {
                 atomicOr(&control[C_BLOCKED + s * INSERT_WINDOW + c], 1u);
             }
         }
@@ -45,11 +47,11 @@ fn insert_place() {
             // Particles placed earlier in this step are not in the parallel check.
             let n = live();
             for (var p = first_new; p < n; p++) {
-                if (touches(cand.anchor, cand.frac, cand.radius, p)) { blocked = true; }
+                if (touches(cand, p)) { blocked = true; }
             }
             if (blocked) { continue; }
             var st: State;
-            st.q[0] = vec4<f32>(cand.frac, 0.0, 0.0);
+            st.q[0] = vec4<f32>(cand.rem, 0.0, 0.0);
             st.q[1] = vec4<f32>(cand.velocity, 0.0, 0.0);
             if (params.integrator == 0u) {
                 // Gear starts with the gravitational acceleration in q2.
@@ -57,8 +59,10 @@ fn insert_place() {
                 st.q[2] = vec4<f32>(h * gravity_at(f32(step)), 0.0, 0.0);
             }
             st.anchor = cand.anchor;
+            st.frac = cand.frac;
             state[n] = st;
-            props[n] = Props(cand.radius, cand.mass, cand.inv_inertia, cand.flags);
+            props[n] = Props(cand.radius, cand.mass, cand.inv_inertia, cand.flags,
+                             cand.radius_units, cand.radius_rem, vec2<u32>(0u));
             atomicStore(&control[C_LIVE], n + 1u);
             sources[s].inserted = k + 1u;
         }

@@ -14,7 +14,8 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = state[i];
     let a = acceleration(i, g);
     s.q[1] += a * params.dt * params.dt;
-    s.q[0] += s.q[1];
+    s.q[0].z += s.q[1].z;
+    displace(&s, s.q[1].xy);
     renormalize(&s);
     state[i] = s;
 }

@@ -84,11 +84,12 @@ fn tapered_energy(delta_f: f32, delta_max: f32, mu_f_n: f32) -> f32 {
     return mu_f_n * (x + 0.4 * delta_max * (pow_pos(1.0 - x / delta_max, 2.5) - 1.0));
 }
 
-fn continuous_force(m: f32, sigma: f32, r: f32) -> f32 {
+// delta = sigma - r, taken from the geometry where it is exact (position.wgsl).
+fn continuous_force(m: f32, sigma: f32, r: f32, delta: f32) -> f32 {
     if (params.elastic == 0u) {
         if (r < params.r0 * sigma) { return m * params.g_scale * pow(sigma / r, params.n_exp + 1.0); }
     } else if (r < sigma) {
-        return params.hooke_k * m * params.g_scale / sigma * (sigma - r);
+        return params.hooke_k * m * params.g_scale / sigma * delta;
     }
     return 0.0;
 }
@@ -104,14 +105,14 @@ fn continuous_stiffness(m: f32, sigma: f32, r: f32) -> f32 {
     return 0.0;
 }
 
-fn continuous_energy(m: f32, sigma: f32, r: f32) -> f32 {
+fn continuous_energy(m: f32, sigma: f32, r: f32, delta: f32) -> f32 {
     if (params.elastic == 0u) {
         if (r < params.r0 * sigma) {
             let n = params.n_exp;
             return m * params.g_scale * sigma / n * (pow(sigma / r, n) - pow(1.0 / params.r0, n));
         }
     } else if (r < sigma) {
-        return 0.5 * params.hooke_k * m * params.g_scale / sigma * (sigma - r) * (sigma - r);
+        return 0.5 * params.hooke_k * m * params.g_scale / sigma * delta * delta;
     }
     return 0.0;
 }
@@ -119,7 +120,7 @@ fn continuous_energy(m: f32, sigma: f32, r: f32) -> f32 {
 // Continuous interaction with tapered friction, paper 001 eq. 3-8.
 fn continuous(c: ContactInput) -> ContactOutput {
     let m = c.mass;
-    let f_e = continuous_force(m, c.sigma, c.r);
+    let f_e = continuous_force(m, c.sigma, c.r, c.delta);
     let k = continuous_stiffness(m, c.sigma, c.r);
     let c_n = params.damping_fraction * 2.0 * sqrt(m * k);       // eq. 3
     let f_n = max(f_e + c_n * c.delta_dot, 0.0);
@@ -132,7 +133,7 @@ fn continuous(c: ContactInput) -> ContactOutput {
     let c_t = params.damping_fraction * 2.0 * sqrt(m * k_t);     // eq. 8
     var f_t = -spring * sign(delta_f) - c_t * c.v_t;
     if (delta_f == 0.0) { f_t = -c_t * c.v_t; }
-    let energy = continuous_energy(m, c.sigma, c.r) + tapered_energy(delta_f, delta_max, mu_f_e);
+    let energy = continuous_energy(m, c.sigma, c.r, c.delta) + tapered_energy(delta_f, delta_max, mu_f_e);
     return ContactOutput(f_n, f_t, delta_f, energy);
 }
 

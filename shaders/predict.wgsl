@@ -7,7 +7,9 @@ fn predict_one(s: ptr<function, State>) {
     let q3 = (*s).q[3];
     let q4 = (*s).q[4];
     let q5 = (*s).q[5];
-    (*s).q[0] += q1 + q2 + q3 + q4 + q5;
+    let step = q1 + q2 + q3 + q4 + q5;
+    (*s).q[0].z += step.z;
+    displace(s, step.xy);
     (*s).q[1] += 2.0 * q2 + 3.0 * q3 + 4.0 * q4 + 5.0 * q5;
     (*s).q[2] += 3.0 * q3 + 6.0 * q4 + 10.0 * q5;
     (*s).q[3] += 4.0 * q4 + 10.0 * q5;

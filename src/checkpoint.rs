@@ -11,6 +11,8 @@ use crate::state::{GEAR_VALUES, Particles};
 use std::path::Path;
 
 const MAGIC: &[u8; 8] = b"TALUSCK1";
+/// Version of the raw device arrays a GPU checkpoint carries (fixed-point positions).
+const DEVICE_LAYOUT: u8 = 2;
 
 #[derive(Debug, thiserror::Error)]
 pub enum CheckpointError {
@@ -58,10 +60,11 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
     e.u64(sim.springs.capacity() as u64);
     sim.springs.keys.iter().for_each(|&k| e.u64(k));
     sim.springs.values.iter().for_each(|&v| e.f64(v));
-    // From a GPU run: the exact device state, for a bitwise GPU resume.
+    // From a GPU run: the exact device state, for a bitwise GPU resume. The flag is the
+    // device layout's version (1: f32 offsets before fixed point; no longer read).
     match &sim.device_state {
         Some(ds) => {
-            e.u8(1);
+            e.u8(DEVICE_LAYOUT);
             for raw in [
                 bytemuck::cast_slice::<_, u8>(&ds.states),
                 bytemuck::cast_slice(&ds.props),
@@ -164,7 +167,8 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
     for _ in 0..cap {
         springs.values.push(d.f64().map_err(corrupt)?);
     }
-    let device_state = if d.u8().map_err(corrupt)? == 1 {
+    let flag = d.u8().map_err(corrupt)?;
+    let device_state = if flag != 0 {
         let mut raw = || -> Result<&[u8], crate::files::DecodeError> {
             let n = d.u64()? as usize;
             d.take(n)
@@ -175,14 +179,19 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
         let sizes_ok = states.len() % size_of::<crate::gpu::layout::State>() == 0
             && props.len() % size_of::<crate::gpu::layout::Props>() == 0
             && springs.len() % size_of::<crate::gpu::layout::Entry>() == 0;
-        if !sizes_ok {
+        if flag != DEVICE_LAYOUT {
+            // An older device layout is skipped: the f64 state above is complete, only
+            // the GPU resume is then not bitwise.
+            None
+        } else if !sizes_ok {
             return Err(corrupt(crate::files::DecodeError(bytes.len())));
+        } else {
+            Some(crate::gpu::DeviceState {
+                states: bytemuck::pod_collect_to_vec(states),
+                props: bytemuck::pod_collect_to_vec(props),
+                springs: bytemuck::pod_collect_to_vec(springs),
+            })
         }
-        Some(crate::gpu::DeviceState {
-            states: bytemuck::pod_collect_to_vec(states),
-            props: bytemuck::pod_collect_to_vec(props),
-            springs: bytemuck::pod_collect_to_vec(springs),
-        })
     } else {
         None
     };

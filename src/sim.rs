@@ -91,12 +91,7 @@ impl Simulation {
             .collect();
         let mut sim =
             Self::from_parts(scene, particles, SpringTable::default(), sources, rng, 0, 0)?;
-        // Start Gear with the gravitational acceleration in q2 so free flight is exact
-        // from the first step.
-        let g = sim.gravity(0.0);
-        for i in 0..sim.particles.len() {
-            sim.seed_acceleration(i, g);
-        }
+        sim.seed_accelerations();
         Ok(sim)
     }
 
@@ -167,11 +162,57 @@ impl Simulation {
             && self.time() >= self.scene.gravity.ramp_time
     }
 
-    fn seed_acceleration(&mut self, i: usize, g: [f64; 2]) {
-        if self.scene.integrator == IntegratorKind::Gear5 && !self.particles.fixed[i] {
-            let h = 0.5 * self.scene.dt * self.scene.dt;
-            self.particles.q[2][i] = [h * g[0], h * g[1], 0.0];
+    /// Starts Gear with the true initial acceleration in q2, (F/m + g) dt²/2 from the
+    /// contact forces of the initial configuration: free flight is exact from the first
+    /// step, and a packing created at rest in its equilibrium stays there instead of
+    /// starting with a kick of g dt²/2.
+    fn seed_accelerations(&mut self) {
+        if self.scene.integrator != IntegratorKind::Gear5 {
+            return;
         }
+        self.cells
+            .build(&self.grid, &self.particles.q[0], &self.particles.active);
+        find_contacts(
+            &self.grid,
+            &self.cells,
+            &self.particles,
+            &self.walls,
+            self.law.range_factor(),
+            &mut self.pairs,
+        );
+        gather_history(&self.springs, &self.pairs, &mut self.history_in);
+        contact_forces(
+            &self.particles,
+            &self.walls,
+            &self.law,
+            self.scene.dt,
+            &self.pairs,
+            &self.history_in,
+            &mut self.contacts,
+            &mut self.history_out,
+        );
+        reduce_forces(
+            &self.particles,
+            &self.pairs,
+            &self.contacts,
+            &mut self.forces,
+        );
+        let g = self.gravity(0.0);
+        let h = 0.5 * self.scene.dt * self.scene.dt;
+        let p = &mut self.particles;
+        for i in 0..p.len() {
+            if p.fixed[i] {
+                continue;
+            }
+            let f = self.forces[i];
+            p.q[2][i] = [
+                h * (f[0] / p.mass[i] + g[0]),
+                h * (f[1] / p.mass[i] + g[1]),
+                h * f[2] / p.inertia[i],
+            ];
+        }
+        self.pairs.clear();
+        self.contacts.clear();
     }
 
     /// One time step: insert, predict, cell list, contacts, springs, forces, reduce,

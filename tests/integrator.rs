@@ -125,3 +125,38 @@ fn energy_is_conserved_without_damping() {
     eprintln!("relative energy drift {worst}");
     assert!(worst < 5e-5, "relative energy drift {worst}");
 }
+
+/// A straight column of disks on a floor, created at its exact equilibrium (contact k
+/// from the bottom carries the 6 − k disks above it: overlap (6 − k) m g / k_n), stays
+/// there: Gear is seeded with the initial forces, (F/m + g) dt²/2, not g dt²/2 alone,
+/// which would kick the column by g dt²/2 and set it ringing (1 % of the top overlap
+/// here, decaying over seconds).
+#[test]
+fn a_column_created_at_equilibrium_stays_there() {
+    let (n, k_n) = (6, 1.0e5);
+    let mut list = Vec::new();
+    let mut z = 0.5 - n as f64 / k_n;
+    for k in 0..n {
+        list.push(json!({ "position": [0.0, z], "diameter": 1.0 }));
+        z += 1.0 - (n - k - 1) as f64 / k_n;
+    }
+    let mut v = scene_value(
+        json!({ "law": "spring_dashpot", "k_n": k_n, "gamma_n": 5.0, "k_t": 0.0, "gamma_t": 0.0, "mu": 0.0 }),
+        json!([{ "kind": "list", "material": "m", "particles": list }]),
+    );
+    v["dt"] = json!(5e-4);
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-1.0, 0.0], "to": [1.0, 0.0] }]);
+    let mut s = sim(&v);
+    let mut worst: f64 = 0.0;
+    for _ in 0..2000 {
+        s.step().unwrap();
+        for (p, c) in s.pairs.iter().zip(&s.contacts) {
+            let above = if p.is_wall() { n } else { n - p.i as usize - 1 };
+            let exact = above as f64 / k_n;
+            worst = worst.max((c.overlap - exact).abs() / exact);
+        }
+    }
+    assert_eq!(s.pairs.len(), n);
+    assert!(worst < 1e-8, "overlaps left the equilibrium by {worst:.2e}");
+}

@@ -1,5 +1,5 @@
 //! The WGSL sources and their compute pipelines. Each stage file in `shaders/` is
-//! compiled after `common.wgsl` and the helper files it uses; every pipeline shares one
+//! compiled after `common.wgsl`, `position.wgsl` and the helper files it uses; every pipeline shares one
 //! pipeline layout (`common.wgsl`'s bindings), so a step binds its buffers once.
 
 /// A shader module: the stage file and the helper files it needs.
@@ -9,50 +9,69 @@ pub struct ModuleSource {
 }
 
 const COMMON: &str = include_str!("../../shaders/common.wgsl");
+const POSITION: &str = include_str!("../../shaders/position.wgsl");
 const GEOMETRY: &str = include_str!("../../shaders/geometry.wgsl");
 const LAWS: &str = include_str!("../../shaders/laws.wgsl");
 
 pub const MODULES: &[ModuleSource] = &[
     ModuleSource {
         name: "insert",
-        parts: &[COMMON, include_str!("../../shaders/insert.wgsl")],
+        parts: &[COMMON, POSITION, include_str!("../../shaders/insert.wgsl")],
     },
     ModuleSource {
         name: "predict",
-        parts: &[COMMON, include_str!("../../shaders/predict.wgsl")],
+        parts: &[COMMON, POSITION, include_str!("../../shaders/predict.wgsl")],
     },
     ModuleSource {
         name: "cell_index",
-        parts: &[COMMON, include_str!("../../shaders/cell_index.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            include_str!("../../shaders/cell_index.wgsl"),
+        ],
     },
     ModuleSource {
         name: "cell_histogram",
-        parts: &[COMMON, include_str!("../../shaders/cell_histogram.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            include_str!("../../shaders/cell_histogram.wgsl"),
+        ],
     },
     ModuleSource {
         name: "prefix_sum",
-        parts: &[COMMON, include_str!("../../shaders/prefix_sum.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            include_str!("../../shaders/prefix_sum.wgsl"),
+        ],
     },
     ModuleSource {
         name: "scatter",
-        parts: &[COMMON, include_str!("../../shaders/scatter.wgsl")],
+        parts: &[COMMON, POSITION, include_str!("../../shaders/scatter.wgsl")],
     },
     ModuleSource {
         name: "find_contacts",
         parts: &[
             COMMON,
+            POSITION,
             GEOMETRY,
             include_str!("../../shaders/find_contacts.wgsl"),
         ],
     },
     ModuleSource {
         name: "gather_history",
-        parts: &[COMMON, include_str!("../../shaders/gather_history.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            include_str!("../../shaders/gather_history.wgsl"),
+        ],
     },
     ModuleSource {
         name: "contact_forces",
         parts: &[
             COMMON,
+            POSITION,
             GEOMETRY,
             LAWS,
             include_str!("../../shaders/contact_forces.wgsl"),
@@ -60,23 +79,39 @@ pub const MODULES: &[ModuleSource] = &[
     },
     ModuleSource {
         name: "store_history",
-        parts: &[COMMON, include_str!("../../shaders/store_history.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            include_str!("../../shaders/store_history.wgsl"),
+        ],
     },
     ModuleSource {
         name: "reduce_forces",
-        parts: &[COMMON, include_str!("../../shaders/reduce_forces.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            include_str!("../../shaders/reduce_forces.wgsl"),
+        ],
     },
     ModuleSource {
         name: "correct",
-        parts: &[COMMON, include_str!("../../shaders/correct.wgsl")],
+        parts: &[COMMON, POSITION, include_str!("../../shaders/correct.wgsl")],
     },
     ModuleSource {
         name: "kick_drift",
-        parts: &[COMMON, include_str!("../../shaders/kick_drift.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            include_str!("../../shaders/kick_drift.wgsl"),
+        ],
     },
     ModuleSource {
         name: "boundaries",
-        parts: &[COMMON, include_str!("../../shaders/boundaries.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            include_str!("../../shaders/boundaries.wgsl"),
+        ],
     },
 ];
 

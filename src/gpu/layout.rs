@@ -74,17 +74,21 @@ pub struct Params {
     pub scan_blocks1: u32,
     pub scan_blocks2: u32,
     pub scan_offset2: u32,
+    /// Fixed-point unit, cell_size / 2^30 (`position.wgsl`), and its inverse.
+    pub unit: f32,
+    pub inv_unit: f32,
     pub _pad: u32,
 }
 
-/// Dynamic state of one particle: q[0] = (frac_x, frac_z, θ, 0) and the scaled Gear
-/// derivatives q[1..6]; the position is `anchor · cell_size + frac` from the grid origin.
+/// Dynamic state of one particle: q[0] = (rem_x, rem_z, θ, 0) and the scaled Gear
+/// derivatives q[1..6]; the position from the grid origin is
+/// `anchor · cell_size + (frac + rem) · unit` (see `position`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct State {
     pub q: [[f32; 4]; 6],
     pub anchor: [i32; 2],
-    pub _pad: [u32; 2],
+    pub frac: [u32; 2],
 }
 
 #[repr(C)]
@@ -94,6 +98,10 @@ pub struct Props {
     pub mass: f32,
     pub inv_inertia: f32,
     pub flags: u32,
+    /// The radius in fixed point: `radius_units + radius_rem` units.
+    pub radius_units: u32,
+    pub radius_rem: f32,
+    pub _pad: [u32; 2],
 }
 
 #[repr(C)]
@@ -108,8 +116,12 @@ pub struct ContactOut {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Wall {
-    pub anchor: [i32; 2],
-    pub frac: [f32; 2],
+    pub a_anchor: [i32; 2],
+    pub a_frac: [u32; 2],
+    pub a_rem: [f32; 2],
+    pub b_anchor: [i32; 2],
+    pub b_frac: [u32; 2],
+    pub b_rem: [f32; 2],
     pub ab: [f32; 2],
     pub _pad: [f32; 2],
 }
@@ -136,13 +148,16 @@ pub struct Source {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct Candidate {
     pub anchor: [i32; 2],
-    pub frac: [f32; 2],
+    pub frac: [u32; 2],
+    pub rem: [f32; 2],
     pub velocity: [f32; 2],
     pub radius: f32,
     pub mass: f32,
     pub inv_inertia: f32,
     pub due_step: u32,
     pub flags: u32,
+    pub radius_units: u32,
+    pub radius_rem: f32,
     pub _pad: u32,
 }
 
@@ -198,13 +213,31 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 scan_blocks1,
                 scan_blocks2,
                 scan_offset2,
+                unit,
+                inv_unit,
                 _pad
             ]
         ),
-        fields!(State, "State", [q, anchor, _pad]),
-        fields!(Props, "Props", [radius, mass, inv_inertia, flags]),
+        fields!(State, "State", [q, anchor, frac]),
+        fields!(
+            Props,
+            "Props",
+            [
+                radius,
+                mass,
+                inv_inertia,
+                flags,
+                radius_units,
+                radius_rem,
+                _pad
+            ]
+        ),
         fields!(ContactOut, "ContactOut", [ft, info]),
-        fields!(Wall, "Wall", [anchor, frac, ab, _pad]),
+        fields!(
+            Wall,
+            "Wall",
+            [a_anchor, a_frac, a_rem, b_anchor, b_frac, b_rem, ab, _pad]
+        ),
         fields!(Entry, "Entry", [i, j, value, _pad]),
         fields!(Source, "Source", [first, count, inserted, _pad]),
         fields!(
@@ -213,12 +246,15 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
             [
                 anchor,
                 frac,
+                rem,
                 velocity,
                 radius,
                 mass,
                 inv_inertia,
                 due_step,
                 flags,
+                radius_units,
+                radius_rem,
                 _pad
             ]
         ),

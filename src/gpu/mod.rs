@@ -13,6 +13,7 @@
 pub mod device;
 pub mod kernels;
 pub mod layout;
+pub mod position;
 
 use crate::contacts::{Pair, WALL_BASE};
 use crate::create::source::{self, SourceState};
@@ -176,11 +177,14 @@ impl GpuSimulation {
                 };
                 let mut one = Particles::default();
                 crate::create::push(&sim.scene, &mut one, &disk);
-                let (anchor, frac) = split(x - origin[0], spec.position[1] - origin[1], cell_size);
+                let (anchor, frac, rem) =
+                    position::split2(x - origin[0], spec.position[1] - origin[1], cell_size);
+                let (radius_units, radius_rem) = position::length_units(one.radius[0], cell_size);
                 let due = source::due_step(source::due_time(spec, st.inserted + k as u32), dt);
                 candidates.push(Candidate {
                     anchor,
                     frac,
+                    rem,
                     velocity: [
                         (spec.velocity[0] * dt) as f32,
                         (spec.velocity[1] * dt) as f32,
@@ -190,6 +194,8 @@ impl GpuSimulation {
                     inv_inertia: (1.0 / one.inertia[0]) as f32,
                     due_step: due.min(u32::MAX as u64) as u32,
                     flags: ACTIVE | (material << 8),
+                    radius_units,
+                    radius_rem,
                     _pad: 0,
                 });
             }
@@ -235,6 +241,8 @@ impl GpuSimulation {
             scan_blocks1: blocks1,
             scan_blocks2: blocks2,
             scan_offset2: blocks1.next_multiple_of(SCAN_WG),
+            unit: position::unit(cell_size) as f32,
+            inv_unit: (1.0 / position::unit(cell_size)) as f32,
             ..Default::default()
         };
         law_params(law, &mut params);
@@ -273,10 +281,17 @@ impl GpuSimulation {
             .walls
             .iter()
             .map(|w| {
-                let (anchor, frac) = split(w.a[0] - origin[0], w.a[1] - origin[1], cell_size);
+                let (a_anchor, a_frac, a_rem) =
+                    position::split2(w.a[0] - origin[0], w.a[1] - origin[1], cell_size);
+                let (b_anchor, b_frac, b_rem) =
+                    position::split2(w.b[0] - origin[0], w.b[1] - origin[1], cell_size);
                 Wall {
-                    anchor,
-                    frac,
+                    a_anchor,
+                    a_frac,
+                    a_rem,
+                    b_anchor,
+                    b_frac,
+                    b_rem,
                     ab: [(w.b[0] - w.a[0]) as f32, (w.b[1] - w.a[1]) as f32],
                     _pad: [0.0; 2],
                 }
@@ -832,40 +847,19 @@ impl GpuSimulation {
     }
 }
 
-/// Splits a position relative to the grid origin into a cell anchor and an f32 offset
-/// in [0, cell).
-pub fn split(x: f64, z: f64, cell: f32) -> ([i32; 2], [f32; 2]) {
-    let l = cell as f64;
-    let one = |v: f64| {
-        let mut a = (v / l).floor();
-        let mut f = (v - a * l) as f32;
-        if f >= cell {
-            f -= cell;
-            a += 1.0;
-        }
-        if f < 0.0 {
-            f += cell;
-            a -= 1.0;
-        }
-        (a as i32, f)
-    };
-    let (ax, fx) = one(x);
-    let (az, fz) = one(z);
-    ([ax, az], [fx, fz])
-}
-
 /// Host f64 particles → device layout.
 pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec<Props>) {
     let mut states = Vec::with_capacity(p.len());
     let mut props = Vec::with_capacity(p.len());
     for i in 0..p.len() {
         let q0 = p.q[0][i];
-        let (anchor, frac) = split(q0[0] - origin[0], q0[1] - origin[1], cell);
+        let (anchor, frac, rem) = position::split2(q0[0] - origin[0], q0[1] - origin[1], cell);
         let mut s = State {
             anchor,
+            frac,
             ..Default::default()
         };
-        s.q[0] = [frac[0], frac[1], q0[2] as f32, 0.0];
+        s.q[0] = [rem[0], rem[1], q0[2] as f32, 0.0];
         for k in 1..GEAR_VALUES {
             let v = p.q[k][i];
             s.q[k] = [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
@@ -873,11 +867,15 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
         states.push(s);
         let flags =
             ((p.active[i] as u32) * ACTIVE) | ((p.fixed[i] as u32) * FIXED) | (p.material[i] << 8);
+        let (radius_units, radius_rem) = position::length_units(p.radius[i], cell);
         props.push(Props {
             radius: p.radius[i] as f32,
             mass: p.mass[i] as f32,
             inv_inertia: (1.0 / p.inertia[i]) as f32,
             flags,
+            radius_units,
+            radius_rem,
+            _pad: [0; 2],
         });
     }
     (states, props)
@@ -885,19 +883,23 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
 
 /// Device layout → host f64 particles.
 pub fn from_device(states: &[State], props: &[Props], origin: [f64; 2], cell: f32) -> Particles {
-    let l = cell as f64;
     let mut p = Particles::default();
     for (s, pr) in states.iter().zip(props) {
-        p.q[0].push([
-            origin[0] + s.anchor[0] as f64 * l + s.q[0][0] as f64,
-            origin[1] + s.anchor[1] as f64 * l + s.q[0][1] as f64,
-            s.q[0][2] as f64,
-        ]);
+        let coord = |k: usize| {
+            let f = position::Fixed {
+                anchor: s.anchor[k],
+                frac: s.frac[k],
+                rem: s.q[0][k],
+            };
+            origin[k] + position::join(f, cell)
+        };
+        p.q[0].push([coord(0), coord(1), s.q[0][2] as f64]);
         for k in 1..GEAR_VALUES {
             let v = s.q[k];
             p.q[k].push([v[0] as f64, v[1] as f64, v[2] as f64]);
         }
-        p.radius.push(pr.radius as f64);
+        p.radius
+            .push((pr.radius_units as f64 + pr.radius_rem as f64) * position::unit(cell));
         p.mass.push(pr.mass as f64);
         p.inertia.push(if pr.inv_inertia == 0.0 {
             f64::INFINITY

@@ -1,0 +1,142 @@
+// Fixed-point positions (SPEC 3 precision; host twin src/gpu/position.rs).
+//
+// A coordinate is a whole cell `anchor` (i32), a whole number of units `frac` in
+// [0, 2^30) below one cell, with unit = cell_size / 2^30 (about 1e-9 of a diameter), and
+// an f32 remainder `rem` in units, kept in [-0.5, 0.5] (q[0].xy of State). Radii are
+// stored the same way (`radius_units` + `radius_rem`).
+//
+// Why: overlaps are 1e-5..1e-2 of a diameter and must be right to 1e-3, so the overlap
+// delta = sigma - |d| needs about 1e-9 d absolute. In f32, |d| ~ sigma ~ 1 d carries only
+// 6e-8 d, and a resting particle's position update (1e-10 d per step) is rounded away.
+// Here the vector between neighbours is an exact i32 number of units plus the difference
+// of two remainders, and |d| is computed as a whole number of units plus a small f32
+// correction from an exact 64-bit integer residual. Nothing relies on the order of
+// float operations (no error-free transformations), so compilers that reassociate or
+// fuse float arithmetic cannot break it; the cost is a few dozen integer operations per
+// pair.
+
+const FRAC_ONE: i32 = 1073741824;   // 2^30 units per cell
+const FRAC_MASK: i32 = 1073741823;
+
+// The vector from point j to point i: exact `d` units plus `e` (remainders), valid when
+// `near` (anchors at most one cell apart, which every pair within range is).
+struct Offset {
+    d: vec2<i32>,
+    e: vec2<f32>,
+    da: vec2<i32>,
+    near: bool,
+};
+
+fn offset(ai: vec2<i32>, fi: vec2<u32>, ri: vec2<f32>,
+          aj: vec2<i32>, fj: vec2<u32>, rj: vec2<f32>) -> Offset {
+    let da = ai - aj;
+    let near = all(abs(da) <= vec2<i32>(1));
+    // Wraps when not near; then only `da` and the f32 vector are used.
+    let d = da * FRAC_ONE + (vec2<i32>(fi) - vec2<i32>(fj));
+    return Offset(d, ri - rj, da, near);
+}
+
+fn offset_ij(i: u32, j: u32) -> Offset {
+    let si = state[i];
+    let sj = state[j];
+    return offset(si.anchor, si.frac, si.q[0].xy, sj.anchor, sj.frac, sj.q[0].xy);
+}
+
+// The offset as an f32 vector in length units, to f32's relative precision of its
+// length wherever the two points are.
+fn offset_vector(o: Offset) -> vec2<f32> {
+    if (o.near) { return (vec2<f32>(o.d) + o.e) * params.unit; }
+    let df = vec2<f32>(o.d - o.da * FRAC_ONE);
+    return vec2<f32>(o.da) * params.cell_size + (df + o.e) * params.unit;
+}
+
+// Position from the grid origin, in f32 (domain checks and output only).
+fn position(s: State) -> vec2<f32> {
+    return vec2<f32>(s.anchor) * params.cell_size + (vec2<f32>(s.frac) + s.q[0].xy) * params.unit;
+}
+
+// --- 64-bit integer arithmetic on (lo, hi) pairs ---
+
+fn mul_wide(a: u32, b: u32) -> vec2<u32> {
+    let a0 = a & 0xFFFFu;
+    let a1 = a >> 16u;
+    let b0 = b & 0xFFFFu;
+    let b1 = b >> 16u;
+    let p00 = a0 * b0;
+    let p01 = a0 * b1;
+    let p10 = a1 * b0;
+    let p11 = a1 * b1;
+    let mid = (p00 >> 16u) + (p01 & 0xFFFFu) + (p10 & 0xFFFFu);
+    let lo = (p00 & 0xFFFFu) | (mid << 16u);
+    let hi = p11 + (p01 >> 16u) + (p10 >> 16u) + (mid >> 16u);
+    return vec2<u32>(lo, hi);
+}
+
+fn add64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    let lo = a.x + b.x;
+    return vec2<u32>(lo, a.y + b.y + select(0u, 1u, lo < a.x));
+}
+
+fn sub64(a: vec2<u32>, b: vec2<u32>) -> vec2<u32> {
+    return vec2<u32>(a.x - b.x, a.y - b.y - select(0u, 1u, a.x < b.x));
+}
+
+// A two's-complement 64-bit integer to the nearest f32 (within 2 roundings).
+fn i64_to_f32(v: vec2<u32>) -> f32 {
+    let negative = (v.y & 0x80000000u) != 0u;
+    var m = v;
+    if (negative) { m = sub64(vec2<u32>(0u, 0u), v); }
+    let x = f32(m.y) * 4294967296.0 + f32(m.x);
+    return select(x, -x, negative);
+}
+
+// |d + e| in units as a whole number `whole` plus an f32 `corr` (|corr| < ~1e3).
+// r0 is |d| rounded in f32; the residual |d + e|^2 - r0^2 = (|d|^2 - r0^2) + 2 d.e + e.e
+// has its large part computed exactly in 64-bit integers, and then
+// |d + e| - r0 = residual / (r0 + |d + e|) without cancellation.
+struct Distance {
+    whole: u32,   // up to 2^31.5 for neighbours one cell apart diagonally
+    corr: f32,
+};
+
+fn distance_units(d: vec2<i32>, e: vec2<f32>) -> Distance {
+    let df = vec2<f32>(d);
+    let r0 = u32(round(length(df)));
+    let ax = u32(abs(d.x));
+    let az = u32(abs(d.y));
+    let exact = sub64(add64(mul_wide(ax, ax), mul_wide(az, az)), mul_wide(r0, r0));
+    let t = i64_to_f32(exact) + 2.0 * dot(df, e) + dot(e, e);
+    let r0f = f32(r0);
+    var corr = 0.0;
+    if (t != 0.0) { corr = t / (r0f + sqrt(max(r0f * r0f + t, 0.0))); }
+    return Distance(r0, corr);
+}
+
+// Moves whole units of the remainder into `frac` and whole cells into `anchor`
+// (exact: rem - round(rem) is representable), so that |rem| <= 0.5 and
+// 0 <= frac < 2^30.
+fn renormalize(s: ptr<function, State>) {
+    for (var k = 0u; k < 2u; k++) {
+        var rem = (*s).q[0][k];
+        var a = (*s).anchor[k];
+        // A move of a cell or more in one step (only while diverging): whole cells first.
+        if (abs(rem) >= 5.0e8) {
+            let c = trunc(rem / f32(FRAC_ONE));
+            rem -= c * f32(FRAC_ONE);
+            a += i32(c);
+        }
+        let whole = round(rem);
+        rem -= whole;
+        let f = i32((*s).frac[k]) + i32(whole);
+        a += f >> 30u;
+        (*s).frac[k] = u32(f & FRAC_MASK);
+        (*s).anchor[k] = a;
+        (*s).q[0][k] = rem;
+    }
+}
+
+// Adds a displacement (length units) to the position.
+fn displace(s: ptr<function, State>, by: vec2<f32>) {
+    let r = (*s).q[0].xy + by * params.inv_unit;
+    (*s).q[0] = vec4<f32>(r, (*s).q[0].zw);
+}
