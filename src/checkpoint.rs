@@ -10,7 +10,9 @@ use crate::springs::SpringTable;
 use crate::state::{GEAR_VALUES, Particles};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"TALUSCK1";
+const MAGIC: &[u8; 8] = b"TALUSCK2";
+/// Checkpoints of talus before polygons (no shapes): named in the error.
+const OLD_MAGIC: &[u8; 8] = b"TALUSCK1";
 /// Version of the raw device arrays a GPU checkpoint carries (fixed-point positions).
 const DEVICE_LAYOUT: u8 = 2;
 
@@ -20,6 +22,10 @@ pub enum CheckpointError {
     Io(String, std::io::Error),
     #[error("{0} is not a talus checkpoint (bad magic)")]
     Magic(String),
+    #[error(
+        "{0} was written by an older talus (format TALUSCK1, before polygons); rerun the scene"
+    )]
+    OldFormat(String),
     #[error("checkpoint {0} is damaged: {1}")]
     Corrupt(String, crate::files::DecodeError),
     #[error("checkpoint {0} holds an invalid scene: {1}")]
@@ -37,10 +43,11 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
     for s in &sim.sources {
         e.u32(s.inserted);
         match s.pending {
-            Some([x, d]) => {
+            Some(c) => {
                 e.u8(1);
-                e.f64(x);
-                e.f64(d);
+                for v in [c.x, c.axes[0], c.axes[1], c.start, c.theta] {
+                    e.f64(v);
+                }
             }
             None => e.u8(0),
         }
@@ -57,6 +64,11 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
     p.fixed.iter().for_each(|&v| e.u8(v as u8));
     p.active.iter().for_each(|&v| e.u8(v as u8));
     p.material.iter().for_each(|&v| e.u32(v));
+    // Polygon corners (body frame): a count per particle (0 for disks), then the corners.
+    for corners in &p.shape {
+        e.u32(corners.len() as u32);
+        corners.iter().flatten().for_each(|&v| e.f64(v));
+    }
     e.u64(sim.springs.capacity() as u64);
     sim.springs.keys.iter().for_each(|&k| e.u64(k));
     sim.springs.values.iter().for_each(|&v| e.f64(v));
@@ -88,6 +100,9 @@ pub fn write(sim: &Simulation, path: &Path) -> std::io::Result<()> {
 pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| CheckpointError::Io(name.clone(), e))?;
+    if bytes.len() >= 8 && &bytes[..8] == OLD_MAGIC {
+        return Err(CheckpointError::OldFormat(name));
+    }
     if bytes.len() < 8 || &bytes[..8] != MAGIC {
         return Err(CheckpointError::Magic(name));
     }
@@ -118,7 +133,16 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
     for _ in 0..n_sources {
         let inserted = d.u32().map_err(corrupt)?;
         let pending = if d.u8().map_err(corrupt)? == 1 {
-            Some([d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?])
+            let mut v = [0.0; 5];
+            for x in &mut v {
+                *x = d.f64().map_err(corrupt)?;
+            }
+            Some(crate::create::source::Drawn {
+                x: v[0],
+                axes: [v[1], v[2]],
+                start: v[3],
+                theta: v[4],
+            })
         } else {
             None
         };
@@ -155,6 +179,17 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
     }
     for _ in 0..n {
         p.material.push(d.u32().map_err(corrupt)?);
+    }
+    for _ in 0..n {
+        let count = d.u32().map_err(corrupt)? as usize;
+        if count > crate::shape::MAX_CORNERS as usize {
+            return Err(corrupt(crate::files::DecodeError(bytes.len())));
+        }
+        let mut corners = Vec::with_capacity(count);
+        for _ in 0..count {
+            corners.push([d.f64().map_err(corrupt)?, d.f64().map_err(corrupt)?]);
+        }
+        p.shape.push(corners);
     }
     let cap = d.u64().map_err(corrupt)? as usize;
     let mut springs = SpringTable {

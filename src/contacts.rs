@@ -3,10 +3,13 @@
 //! For each active particle i (in id order) the 3×3 block of cells around it is scanned
 //! and every j > i within the law's range becomes a contact, followed by i's wall
 //! contacts. The list is therefore ordered by i, which fixes the order of every later sum.
-//! Pairs of two fixed particles are skipped: neither moves.
+//! Pairs of two fixed particles are skipped: neither moves. Polygons are first screened by
+//! their circumscribed circles, then kept when their outlines overlap.
 
 use crate::cell_list::{CellList, Grid};
 use crate::geometry::{WallSegment, disk_disk, disk_wall};
+use crate::overlap::{polygon_polygon, polygon_wall};
+use crate::shape::WorldShapes;
 use crate::state::Particles;
 
 /// Ids at and above this refer to walls: `WALL_BASE + wall index`.
@@ -25,12 +28,53 @@ impl Pair {
     }
 }
 
+/// Whether particles i and j interact: disks within `range_factor` · σ, polygons whose
+/// circumscribed circles overlap and whose outlines intersect (SPEC 2.3).
+pub fn interacts(
+    particles: &Particles,
+    shapes: &WorldShapes,
+    range_factor: f64,
+    i: usize,
+    j: usize,
+) -> bool {
+    let pos = &particles.q[0];
+    let (pi, pj) = ([pos[i][0], pos[i][1]], [pos[j][0], pos[j][1]]);
+    let g = disk_disk(pi, particles.radius[i], pj, particles.radius[j]);
+    if !(g.r < range_factor * g.sigma) {
+        return false;
+    }
+    if particles.is_polygon(i) {
+        return polygon_polygon(shapes.of(i), pi, shapes.of(j), pj).is_some();
+    }
+    true
+}
+
+/// Whether particle i touches wall w.
+pub fn touches_wall(
+    particles: &Particles,
+    shapes: &WorldShapes,
+    range_factor: f64,
+    i: usize,
+    wall: &WallSegment,
+) -> bool {
+    let pi = particles.position(i);
+    let g = disk_wall(pi, particles.radius[i], wall);
+    if !(g.r < range_factor * g.sigma) {
+        return false;
+    }
+    if particles.is_polygon(i) {
+        return polygon_wall(shapes.of(i), pi, wall).is_some();
+    }
+    true
+}
+
 /// Finds all interacting pairs. `range_factor` scales σ = r_i + r_j to the interaction
 /// distance (1 for the spring-dashpot law, r0 for the continuous one).
 pub fn find_contacts(
     grid: &Grid,
     cells: &CellList,
     particles: &Particles,
+    shapes: &WorldShapes,
     walls: &[WallSegment],
     range_factor: f64,
     out: &mut Vec<Pair>,
@@ -51,13 +95,7 @@ pub fn find_contacts(
                     if ju <= i || (particles.fixed[i] && particles.fixed[ju]) {
                         continue;
                     }
-                    let g = disk_disk(
-                        pi,
-                        particles.radius[i],
-                        [pos[ju][0], pos[ju][1]],
-                        particles.radius[ju],
-                    );
-                    if g.r < range_factor * g.sigma {
+                    if interacts(particles, shapes, range_factor, i, ju) {
                         out.push(Pair { i: i as u32, j });
                     }
                 }
@@ -70,8 +108,7 @@ pub fn find_contacts(
             continue;
         }
         for (w, wall) in walls.iter().enumerate() {
-            let g = disk_wall(pi, particles.radius[i], wall);
-            if g.r < range_factor * g.sigma {
+            if touches_wall(particles, shapes, range_factor, i, wall) {
                 out.push(Pair {
                     i: i as u32,
                     j: WALL_BASE + w as u32,
@@ -84,11 +121,11 @@ pub fn find_contacts(
 /// Reference O(N²) search used by tests to check `find_contacts`.
 pub fn brute_force_contacts(
     particles: &Particles,
+    shapes: &WorldShapes,
     walls: &[WallSegment],
     range_factor: f64,
 ) -> Vec<Pair> {
     let mut out = Vec::new();
-    let pos = &particles.q[0];
     for i in 0..particles.len() {
         if !particles.active[i] {
             continue;
@@ -97,13 +134,7 @@ pub fn brute_force_contacts(
             if !particles.active[j] || (particles.fixed[i] && particles.fixed[j]) {
                 continue;
             }
-            let g = disk_disk(
-                [pos[i][0], pos[i][1]],
-                particles.radius[i],
-                [pos[j][0], pos[j][1]],
-                particles.radius[j],
-            );
-            if g.r < range_factor * g.sigma {
+            if interacts(particles, shapes, range_factor, i, j) {
                 out.push(Pair {
                     i: i as u32,
                     j: j as u32,
@@ -114,8 +145,7 @@ pub fn brute_force_contacts(
             continue;
         }
         for (w, wall) in walls.iter().enumerate() {
-            let g = disk_wall([pos[i][0], pos[i][1]], particles.radius[i], wall);
-            if g.r < range_factor * g.sigma {
+            if touches_wall(particles, shapes, range_factor, i, wall) {
                 out.push(Pair {
                     i: i as u32,
                     j: WALL_BASE + w as u32,

@@ -10,6 +10,8 @@
 use crate::contacts::{Pair, WALL_BASE};
 use crate::geometry::{Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent};
 use crate::law::{ContactInput, ContactLaw};
+use crate::overlap::{polygon_polygon, polygon_wall};
+use crate::shape::WorldShapes;
 use crate::state::{Dof, Particles};
 
 /// The result of one contact, kept for outputs and the reduction.
@@ -32,6 +34,7 @@ pub struct ContactForce {
 /// Stage: forces of every contact, and the updated tangential history.
 pub fn contact_forces(
     particles: &Particles,
+    shapes: &WorldShapes,
     walls: &[WallSegment],
     law: &ContactLaw,
     dt: f64,
@@ -43,7 +46,7 @@ pub fn contact_forces(
     out.clear();
     history_out.clear();
     for (&pair, &history) in pairs.iter().zip(history_in) {
-        let (g, input) = contact_input(particles, walls, dt, pair, history);
+        let (g, input) = contact_input(particles, shapes, walls, dt, pair, history);
         let res = law.evaluate(&input);
         let t = tangent(g.n);
         let force = [
@@ -66,12 +69,16 @@ pub fn contact_forces(
 /// Geometry and kinematics of one contact: what the law needs.
 pub fn contact_input(
     particles: &Particles,
+    shapes: &WorldShapes,
     walls: &[WallSegment],
     dt: f64,
     pair: Pair,
     history: f64,
 ) -> (Geometry, ContactInput) {
     let i = pair.i as usize;
+    if particles.is_polygon(i) {
+        return area_contact_input(particles, shapes, walls, dt, pair, history);
+    }
     let p1 = particles.position(i);
     let v1 = particles.velocity(i, dt);
     let (g, v2, w2, m2) = if pair.is_wall() {
@@ -125,6 +132,80 @@ pub fn contact_input(
         mass,
         history,
         dt,
+    };
+    (g, input)
+}
+
+/// Velocity of particle j's material at the point x (zero for a wall), and its mass.
+fn material_velocity(particles: &Particles, dt: f64, pair: Pair, x: [f64; 2]) -> ([f64; 2], f64) {
+    if pair.is_wall() {
+        return ([0.0, 0.0], f64::INFINITY);
+    }
+    let j = pair.j as usize;
+    let v = particles.velocity(j, dt);
+    let p = particles.position(j);
+    let s = spin_velocity(v[2], [x[0] - p[0], x[1] - p[1]]);
+    ([v[0] + s[0], v[1] + s[1]], particles.mass[j])
+}
+
+/// Geometry and kinematics of a polygon contact (SPEC 2.3, src/law/overlap_area.rs): the
+/// law sees δ = A/l, its rate L v_n / l and the depth A/L. A pair that no longer
+/// overlaps (possible only between finding and evaluating, which see the same state)
+/// gives zero input.
+fn area_contact_input(
+    particles: &Particles,
+    shapes: &WorldShapes,
+    walls: &[WallSegment],
+    dt: f64,
+    pair: Pair,
+    history: f64,
+) -> (Geometry, ContactInput) {
+    let i = pair.i as usize;
+    let p1 = particles.position(i);
+    let c = if pair.is_wall() {
+        polygon_wall(shapes.of(i), p1, &walls[(pair.j - WALL_BASE) as usize])
+    } else {
+        let j = pair.j as usize;
+        polygon_polygon(shapes.of(i), p1, shapes.of(j), particles.position(j))
+    }
+    .unwrap_or_default();
+    let v1 = particles.velocity(i, dt);
+    let s1 = spin_velocity(v1[2], [c.point[0] - p1[0], c.point[1] - p1[1]]);
+    let (v2, m2) = material_velocity(particles, dt, pair, c.point);
+    let v12 = [v1[0] + s1[0] - v2[0], v1[1] + s1[1] - v2[1]];
+    let t = tangent(c.n);
+    let m1 = particles.mass[i];
+    let m12 = if m2.is_infinite() {
+        m1
+    } else {
+        m1 * m2 / (m1 + m2)
+    };
+    let (delta, depth) = if c.l > 0.0 {
+        (
+            c.area / c.l,
+            if c.chord > 0.0 { c.area / c.chord } else { 0.0 },
+        )
+    } else {
+        (0.0, 0.0)
+    };
+    let v_n = -(v12[0] * c.n[0] + v12[1] * c.n[1]);
+    let input = ContactInput {
+        delta,
+        r: depth,
+        sigma: 0.0,
+        delta_dot: if c.l > 0.0 { c.chord * v_n / c.l } else { 0.0 },
+        v_t: v12[0] * t[0] + v12[1] * t[1],
+        m12,
+        mass: 2.0 * m12,
+        history,
+        dt,
+    };
+    let g = Geometry {
+        n: c.n,
+        delta,
+        r: depth,
+        sigma: 0.0,
+        point: c.point,
     };
     (g, input)
 }

@@ -11,6 +11,7 @@ use crate::integrate::{gear, leapfrog};
 use crate::law::ContactLaw;
 use crate::rng::Rng;
 use crate::scene::{Creation, IntegratorKind, Scene, SceneError};
+use crate::shape::{WorldShapes, world_shapes};
 use crate::springs::{SpringTable, gather_history, store_history};
 use crate::state::{Dof, Particles};
 
@@ -70,6 +71,8 @@ pub struct Simulation {
     pub device_state: Option<crate::gpu::DeviceState>,
     // Per-step buffers, rebuilt every step (not part of the state).
     pub cells: CellList,
+    /// World corners of the polygons at the current step.
+    pub shapes: WorldShapes,
     pub pairs: Vec<Pair>,
     pub contacts: Vec<ContactForce>,
     history_in: Vec<f64>,
@@ -127,6 +130,7 @@ impl Simulation {
             lost,
             device_state: None,
             cells: CellList::default(),
+            shapes: WorldShapes::default(),
             pairs: Vec::new(),
             contacts: Vec::new(),
             history_in: Vec::new(),
@@ -172,10 +176,12 @@ impl Simulation {
         }
         self.cells
             .build(&self.grid, &self.particles.q[0], &self.particles.active);
+        world_shapes(&self.particles, &mut self.shapes);
         find_contacts(
             &self.grid,
             &self.cells,
             &self.particles,
+            &self.shapes,
             &self.walls,
             self.law.range_factor(),
             &mut self.pairs,
@@ -183,6 +189,7 @@ impl Simulation {
         gather_history(&self.springs, &self.pairs, &mut self.history_in);
         contact_forces(
             &self.particles,
+            &self.shapes,
             &self.walls,
             &self.law,
             self.scene.dt,
@@ -227,10 +234,12 @@ impl Simulation {
         }
         self.cells
             .build(&self.grid, &self.particles.q[0], &self.particles.active);
+        world_shapes(&self.particles, &mut self.shapes);
         find_contacts(
             &self.grid,
             &self.cells,
             &self.particles,
+            &self.shapes,
             &self.walls,
             self.law.range_factor(),
             &mut self.pairs,
@@ -238,6 +247,7 @@ impl Simulation {
         gather_history(&self.springs, &self.pairs, &mut self.history_in);
         contact_forces(
             &self.particles,
+            &self.shapes,
             &self.walls,
             &self.law,
             dt,

@@ -157,6 +157,24 @@ pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBu
         "",
         Column::U32(ids.iter().map(|&i| p.material[i]).collect()),
     );
+    // Polygons: the corner count per particle (0 for disks), then every corner in the
+    // body frame (rotate by theta and add (x, z) for the world frame), particle by
+    // particle.
+    b.push(
+        "particles",
+        "corners",
+        "",
+        Column::U32(ids.iter().map(|&i| p.shape[i].len() as u32).collect()),
+    );
+    let body = |k: usize| {
+        Column::F64(
+            ids.iter()
+                .flat_map(|&i| p.shape[i].iter().map(move |v| v[k]))
+                .collect(),
+        )
+    };
+    b.push("corners", "x", len, body(0));
+    b.push("corners", "z", len, body(1));
     let c = &sim.contacts;
     let pairs = &sim.pairs;
     let cf = |g: &dyn Fn(usize) -> f64| Column::F64((0..c.len()).map(g).collect());

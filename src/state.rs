@@ -9,6 +9,8 @@
 /// (x, z, θ) or its derivatives.
 pub type Dof = [f64; 3];
 
+use crate::shape::{self, P2};
+
 /// Gear order + 1: the number of stored values per degree of freedom.
 pub const GEAR_VALUES: usize = 6;
 
@@ -23,11 +25,14 @@ pub struct Particles {
     /// Cleared when a particle leaves the domain; its id is never reused.
     pub active: Vec<bool>,
     pub material: Vec<u32>,
+    /// Polygon corners in the body frame (counter-clockwise, centroid at the origin);
+    /// empty for a disk. `radius` is then the circumscribed radius.
+    pub shape: Vec<Vec<P2>>,
 }
 
-/// A new disk before it joins the state.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NewDisk {
+/// A new particle before it joins the state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NewParticle {
     pub position: [f64; 2],
     pub theta: f64,
     pub velocity: [f64; 2],
@@ -37,6 +42,8 @@ pub struct NewDisk {
     /// Infinite moment of inertia: the particle never turns.
     pub fixed_rotation: bool,
     pub material: u32,
+    /// Polygon corners in the body frame (see `shape`); empty for a disk.
+    pub corners: Vec<P2>,
 }
 
 impl Particles {
@@ -48,11 +55,21 @@ impl Particles {
         self.radius.is_empty()
     }
 
-    /// Appends a disk; mass = density · area · thickness, I = m r²/2 (SPEC 1; paper 001's
-    /// I = m σ²/8 for a disk of diameter σ).
-    pub fn push_disk(&mut self, d: &NewDisk, density: f64, thickness: f64, dt: f64) -> u32 {
+    /// Appends a particle; mass = density · area · thickness. A disk has I = m r²/2 (SPEC
+    /// 1; paper 001's I = m σ²/8 for a disk of diameter σ), a polygon the moment of its
+    /// actual area, density · thickness · ∫ r² dA about the centroid.
+    pub fn push_particle(&mut self, d: &NewParticle, density: f64, thickness: f64, dt: f64) -> u32 {
         let id = self.len() as u32;
-        let mass = density * std::f64::consts::PI * d.radius * d.radius * thickness;
+        let (mass, inertia) = if d.corners.is_empty() {
+            let mass = density * std::f64::consts::PI * d.radius * d.radius * thickness;
+            (mass, 0.5 * mass * d.radius * d.radius)
+        } else {
+            let rho = density * thickness;
+            (
+                rho * shape::area(&d.corners),
+                rho * shape::polar_moment(&d.corners),
+            )
+        };
         self.q[0].push([d.position[0], d.position[1], d.theta]);
         self.q[1].push([d.velocity[0] * dt, d.velocity[1] * dt, d.omega * dt]);
         for k in 2..GEAR_VALUES {
@@ -63,11 +80,12 @@ impl Particles {
         self.inertia.push(if d.fixed_rotation {
             f64::INFINITY
         } else {
-            0.5 * mass * d.radius * d.radius
+            inertia
         });
         self.fixed.push(d.fixed);
         self.active.push(true);
         self.material.push(d.material);
+        self.shape.push(d.corners.clone());
         id
     }
 
@@ -89,6 +107,10 @@ impl Particles {
         (0..self.len())
             .filter(|&i| self.active[i] && !self.fixed[i])
             .count()
+    }
+
+    pub fn is_polygon(&self, i: usize) -> bool {
+        !self.shape[i].is_empty()
     }
 
     pub fn max_radius(&self) -> f64 {

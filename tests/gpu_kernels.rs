@@ -167,6 +167,7 @@ fn find_contacts_matches_the_cpu_for_both_laws() {
             &grid,
             &cells,
             &host.particles,
+            &host.shapes,
             &host.walls,
             host.law.range_factor(),
             &mut cpu,
@@ -234,6 +235,7 @@ fn contact_forces_and_reduction_match_the_cpu() {
         let (mut cpu, mut hist_out) = (Vec::new(), Vec::new());
         contact_forces(
             &host.particles,
+            &host.shapes,
             &host.walls,
             &host.law,
             host.dt(),

@@ -9,7 +9,7 @@
 
 use crate::rng::Rng;
 use crate::scene::LatticePile;
-use crate::state::NewDisk;
+use crate::state::NewParticle;
 
 /// Number of rows H for a pile with L disks at the bottom.
 pub fn rows(slope: f64, bottom_row: u32) -> u32 {
@@ -29,7 +29,7 @@ pub fn row_length(slope: f64, bottom_row: u32, m: u32) -> u32 {
     }
 }
 
-pub fn pile(p: &LatticePile, material: u32, rng: &mut Rng) -> Vec<NewDisk> {
+pub fn pile(p: &LatticePile, material: u32, rng: &mut Rng) -> Vec<NewParticle> {
     let d0 = p.diameter;
     let a = d0 * (1.0 + p.spacing_c);
     let h = (d0 * d0 - 0.25 * a * a).sqrt();
@@ -46,15 +46,19 @@ pub fn pile(p: &LatticePile, material: u32, rng: &mut Rng) -> Vec<NewDisk> {
             } else {
                 d0 * (1.0 + rng.range(-0.5 * p.size_disorder, 0.5 * p.size_disorder))
             };
-            out.push(NewDisk {
+            // Polygons are turned by π/C: for C divisible by 6 flat faces, not corners,
+            // face the six lattice neighbours.
+            let (radius, corners) = super::regular_shape(p.polygon.as_ref(), diameter, true);
+            out.push(NewParticle {
                 position: [x, z],
                 theta: 0.0,
                 velocity: [0.0; 2],
                 omega: 0.0,
-                radius: 0.5 * diameter,
+                radius,
                 fixed,
                 fixed_rotation: false,
                 material,
+                corners,
             });
         }
     }
@@ -76,6 +80,7 @@ mod tests {
             fixed_bottom: true,
             center_x: 0.0,
             base_z: 0.0,
+            polygon: None,
         }
     }
 

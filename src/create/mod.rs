@@ -5,8 +5,9 @@ pub mod lattice;
 pub mod source;
 
 use crate::rng::Rng;
-use crate::scene::{Creation, Scene};
-use crate::state::{NewDisk, Particles};
+use crate::scene::{Creation, PolygonSpec, Scene};
+use crate::shape::{self, P2};
+use crate::state::{NewParticle, Particles};
 
 /// Index of each material name (in the scene's sorted order).
 pub fn material_index(scene: &Scene, name: &str) -> u32 {
@@ -17,14 +18,47 @@ pub fn material_index(scene: &Scene, name: &str) -> u32 {
         .expect("validated material") as u32
 }
 
-/// Adds one disk with its material's density and thickness.
-pub fn push(scene: &Scene, particles: &mut Particles, disk: &NewDisk) -> u32 {
+/// The reach (radius, circumscribed for a polygon) and corners of a particle with full
+/// axes (a, b) and start angle φ0 on the ellipse: a disk of diameter a without a
+/// polygon spec.
+pub fn shape_of(polygon: Option<&PolygonSpec>, a: f64, b: f64, start: f64) -> (f64, Vec<P2>) {
+    match polygon {
+        None => (0.5 * a, Vec::new()),
+        Some(p) => {
+            let corners = shape::ellipse_polygon(p.corners, a, b, start);
+            (shape::circumradius(&corners), corners)
+        }
+    }
+}
+
+/// A regular polygon (or a disk) of `diameter`. Free particles (lists, sources) are
+/// inscribed in the circle of that diameter with a corner at φ0 = 0. On a lattice or a
+/// row (`lattice`) the diameter is the inscribed, face-to-face one and a face points
+/// along +x (φ0 = π/C), so that neighbours one diameter apart touch face to face when C
+/// is divisible by 6.
+pub fn regular_shape(
+    polygon: Option<&PolygonSpec>,
+    diameter: f64,
+    lattice: bool,
+) -> (f64, Vec<P2>) {
+    match polygon {
+        Some(p) if lattice => {
+            let half_angle = std::f64::consts::PI / p.corners as f64;
+            let d = diameter / half_angle.cos();
+            shape_of(polygon, d, d, half_angle)
+        }
+        _ => shape_of(polygon, diameter, diameter, 0.0),
+    }
+}
+
+/// Adds one particle with its material's density and thickness.
+pub fn push(scene: &Scene, particles: &mut Particles, disk: &NewParticle) -> u32 {
     let m = scene
         .materials
         .values()
         .nth(disk.material as usize)
         .expect("validated material");
-    particles.push_disk(disk, m.density, m.thickness, scene.dt)
+    particles.push_particle(disk, m.density, m.thickness, scene.dt)
 }
 
 /// Creates every particle that exists at t = 0, in block order; draws from `rng` in a
@@ -42,15 +76,17 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
             Creation::Row(r) => {
                 let material = material_index(scene, &r.material);
                 for k in 0..r.count {
-                    let d = NewDisk {
+                    let (radius, corners) = regular_shape(r.polygon.as_ref(), r.diameter, true);
+                    let d = NewParticle {
                         position: [r.start[0] + k as f64 * r.spacing, r.start[1]],
                         theta: 0.0,
                         velocity: [0.0; 2],
                         omega: 0.0,
-                        radius: 0.5 * r.diameter,
+                        radius,
                         fixed: r.fixed,
                         fixed_rotation: false,
                         material,
+                        corners,
                     };
                     push(scene, &mut particles, &d);
                 }
@@ -58,15 +94,17 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
             Creation::List(l) => {
                 let material = material_index(scene, &l.material);
                 for p in &l.particles {
-                    let d = NewDisk {
+                    let (radius, corners) = regular_shape(l.polygon.as_ref(), p.diameter, false);
+                    let d = NewParticle {
                         position: p.position,
                         theta: p.theta,
                         velocity: p.velocity,
                         omega: p.omega,
-                        radius: 0.5 * p.diameter,
+                        radius,
                         fixed: p.fixed,
                         fixed_rotation: p.fixed_rotation,
                         material,
+                        corners,
                     };
                     push(scene, &mut particles, &d);
                 }

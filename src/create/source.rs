@@ -6,8 +6,8 @@
 //! this to draw the candidates on the host ahead of time ([`upcoming`]).
 
 use crate::rng::Rng;
-use crate::scene::PointSource;
-use crate::state::{NewDisk, Particles};
+use crate::scene::{PointSource, Size};
+use crate::state::{NewParticle, Particles};
 
 /// At most this many particles of one source are placed in one step (the GPU's
 /// `INSERT_WINDOW`; both paths use it so that they insert on the same steps).
@@ -17,8 +17,8 @@ pub const MAX_PER_STEP: u32 = 4;
 #[derive(Clone, Debug, PartialEq)]
 pub struct SourceState {
     pub inserted: u32,
-    /// A particle drawn but not yet placed: (x, diameter).
-    pub pending: Option<[f64; 2]>,
+    /// A particle drawn but not yet placed.
+    pub pending: Option<Drawn>,
     /// The source's own random stream.
     pub rng: Rng,
 }
@@ -39,12 +39,23 @@ impl SourceState {
     }
 }
 
-/// The candidates (x, diameter) a source will place next, in order: the pending one,
-/// then fresh draws, up to the source's count.
-pub fn upcoming(spec: &PointSource, state: &SourceState) -> Vec<[f64; 2]> {
+/// One particle as drawn by a source: its outlet x, the ellipse's full axes (a, b; a
+/// disk's diameter twice), the start angle φ0 of the corners on the ellipse and the
+/// orientation θ (both 0 for disks).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Drawn {
+    pub x: f64,
+    pub axes: [f64; 2],
+    pub start: f64,
+    pub theta: f64,
+}
+
+/// The candidates a source will place next, in order: the pending one, then fresh
+/// draws, up to the source's count.
+pub fn upcoming(spec: &PointSource, state: &SourceState) -> Vec<Drawn> {
     let left = spec.count.saturating_sub(state.inserted) as usize;
     let mut rng = state.rng.clone();
-    let mut out: Vec<[f64; 2]> = state.pending.into_iter().collect();
+    let mut out: Vec<Drawn> = state.pending.into_iter().collect();
     while out.len() < left {
         out.push(draw(spec, &mut rng));
     }
@@ -85,12 +96,61 @@ pub fn due_time(spec: &PointSource, k: u32) -> f64 {
     spec.start_time + k as f64 / spec.rate
 }
 
-/// Draws the next particle of a source: (x, diameter).
-fn draw(spec: &PointSource, rng: &mut Rng) -> [f64; 2] {
+fn size(s: &Size, rng: &mut Rng) -> f64 {
+    let (lo, hi) = s.bounds();
+    if lo == hi { lo } else { rng.range(lo, hi) }
+}
+
+/// Draws the next particle of a source, always in the same order: x, the size (one
+/// diameter, or the two axes), then for polygons φ0 (if irregular) and θ, uniform in
+/// [0, 2π/C) and [0, 2π).
+fn draw(spec: &PointSource, rng: &mut Rng) -> Drawn {
     let x = spec.position[0] + rng.range(-spec.spread, spec.spread);
-    let (lo, hi) = crate::scene::Size::bounds(&spec.diameter);
-    let d = if lo == hi { lo } else { rng.range(lo, hi) };
-    [x, d]
+    let axes = match (&spec.polygon, &spec.diameter) {
+        (
+            Some(crate::scene::PolygonSpec {
+                axes: Some([a, b]), ..
+            }),
+            _,
+        ) => {
+            let a = size(a, rng);
+            [a, size(b, rng)]
+        }
+        (_, Some(d)) => {
+            let d = size(d, rng);
+            [d, d]
+        }
+        (_, None) => unreachable!("validated: a point source has a diameter or polygon axes"),
+    };
+    let (mut start, mut theta) = (0.0, 0.0);
+    if let Some(p) = &spec.polygon {
+        if p.irregular {
+            start = rng.range(0.0, std::f64::consts::TAU / p.corners as f64);
+        }
+        theta = rng.range(0.0, std::f64::consts::TAU);
+    }
+    Drawn {
+        x,
+        axes,
+        start,
+        theta,
+    }
+}
+
+/// The particle a drawn candidate becomes (at the outlet, not yet placed).
+pub fn particle(spec: &PointSource, c: &Drawn, material: u32) -> NewParticle {
+    let (radius, corners) = super::shape_of(spec.polygon.as_ref(), c.axes[0], c.axes[1], c.start);
+    NewParticle {
+        position: [c.x, spec.position[1]],
+        theta: c.theta,
+        velocity: spec.velocity,
+        omega: 0.0,
+        radius,
+        fixed: false,
+        fixed_rotation: false,
+        material,
+        corners,
+    }
 }
 
 /// Whether a disk at `p` with radius `r` would touch an active particle.
@@ -113,35 +173,28 @@ pub fn emit(
     t: f64,
     material: u32,
     particles: &Particles,
-) -> Vec<NewDisk> {
+) -> Vec<NewParticle> {
     let mut out = Vec::new();
     while !state.done(spec)
         && t >= due_time(spec, state.inserted)
         && (out.len() as u32) < MAX_PER_STEP
     {
-        let [x, d] = match state.pending.take() {
+        let drawn = match state.pending.take() {
             Some(p) => p,
             None => draw(spec, &mut state.rng),
         };
-        let pos = [x, spec.position[1]];
-        let fresh_ok = out.iter().all(|o: &NewDisk| {
+        let new = particle(spec, &drawn, material);
+        let pos = new.position;
+        // The spot is free when the circumscribed circles do not touch.
+        let fresh_ok = out.iter().all(|o: &NewParticle| {
             let (dx, dz) = (o.position[0] - pos[0], o.position[1] - pos[1]);
-            dx * dx + dz * dz >= (o.radius + 0.5 * d).powi(2)
+            dx * dx + dz * dz >= (o.radius + new.radius).powi(2)
         });
-        if !(fresh_ok && is_free(particles, pos, 0.5 * d)) {
-            state.pending = Some([x, d]);
+        if !(fresh_ok && is_free(particles, pos, new.radius)) {
+            state.pending = Some(drawn);
             break;
         }
-        out.push(NewDisk {
-            position: pos,
-            theta: 0.0,
-            velocity: spec.velocity,
-            omega: 0.0,
-            radius: 0.5 * d,
-            fixed: false,
-            fixed_rotation: false,
-            material,
-        });
+        out.push(new);
         state.inserted += 1;
     }
     out

@@ -23,7 +23,7 @@ use crate::law::ContactLaw;
 use crate::scene::{Creation, IntegratorKind, PointSource};
 use crate::sim::{Divergence, Simulation};
 use crate::springs::{SpringTable, pair_key};
-use crate::state::{GEAR_VALUES, NewDisk, Particles};
+use crate::state::{GEAR_VALUES, Particles};
 use device::{DeviceError, Gpu};
 use kernels::{Kernel, Pipelines};
 use layout::*;
@@ -107,6 +107,8 @@ pub enum GpuError {
     Device(#[from] DeviceError),
     #[error("GPU readback failed: {0}")]
     Readback(String),
+    #[error("{0} (use --backend cpu)")]
+    Unsupported(String),
 }
 
 fn ceil_div(a: u64, b: u64) -> u64 {
@@ -120,6 +122,11 @@ impl GpuSimulation {
     }
 
     pub fn with_gpu(mut sim: Simulation, gpu: Gpu) -> Result<Self, GpuError> {
+        if matches!(sim.law, ContactLaw::OverlapArea(_)) {
+            return Err(GpuError::Unsupported(
+                "polygons are not on the GPU path yet".into(),
+            ));
+        }
         let device_state = sim.device_state.take();
         let grid = sim.grid.clone();
         let cells = grid.cell_count() as u64;
@@ -164,17 +171,9 @@ impl GpuSimulation {
                 _pad: 0,
             });
             let material = crate::create::material_index(&sim.scene, &spec.material);
-            for (k, [x, d]) in list.into_iter().enumerate() {
-                let disk = NewDisk {
-                    position: [x, spec.position[1]],
-                    theta: 0.0,
-                    velocity: spec.velocity,
-                    omega: 0.0,
-                    radius: 0.5 * d,
-                    fixed: false,
-                    fixed_rotation: false,
-                    material,
-                };
+            for (k, drawn) in list.into_iter().enumerate() {
+                let disk = source::particle(spec, &drawn, material);
+                let x = drawn.x;
                 let mut one = Particles::default();
                 crate::create::push(&sim.scene, &mut one, &disk);
                 let (anchor, frac, rem) =
@@ -909,6 +908,7 @@ pub fn from_device(states: &[State], props: &[Props], origin: [f64; 2], cell: f3
         p.fixed.push(pr.flags & FIXED != 0);
         p.active.push(pr.flags & ACTIVE != 0);
         p.material.push(pr.flags >> 8);
+        p.shape.push(Vec::new()); // the GPU path runs disks only
     }
     p
 }
@@ -963,6 +963,7 @@ fn law_params(law: &ContactLaw, p: &mut Params) {
             p.mu = l.mu as f32;
             p.clamp = l.clamp as u32;
         }
+        ContactLaw::OverlapArea(_) => unreachable!("refused in GpuSimulation::with_gpu"),
         ContactLaw::Continuous(c) => {
             p.law = 1;
             match c.elastic {

@@ -7,6 +7,7 @@
 //! equation next to it, so a WGSL twin can be written line for line.
 
 pub mod continuous;
+pub mod overlap_area;
 pub mod spring_dashpot;
 pub mod tangential;
 
@@ -18,7 +19,8 @@ pub struct ContactInput {
     /// Geometric overlap δ (SPEC 2.1): (d1 + d2)/2 − r for disks, R − distance for walls.
     pub delta: f64,
     /// Centre distance r and mean diameter σ seen by the continuous law (paper 001); for
-    /// a wall the mirror image: r = 2·distance, σ = d.
+    /// a wall the mirror image: r = 2·distance, σ = d. For area contacts δ is A/l and r
+    /// the penetration depth A/L (SPEC 2.3, src/law/overlap_area.rs).
     pub r: f64,
     pub sigma: f64,
     /// Rate of overlap dδ/dt = −v12·n.
@@ -49,6 +51,7 @@ pub struct ContactOutput {
 #[derive(Clone, Debug, PartialEq)]
 pub enum ContactLaw {
     SpringDashpot(spring_dashpot::SpringDashpot),
+    OverlapArea(overlap_area::OverlapArea),
     Continuous(continuous::Continuous),
 }
 
@@ -60,6 +63,9 @@ impl ContactLaw {
             ContactSpec::SpringDashpot(s) => Ok(Self::SpringDashpot(
                 spring_dashpot::SpringDashpot::from_spec(s)?,
             )),
+            ContactSpec::OverlapArea(s) => {
+                Ok(Self::OverlapArea(overlap_area::OverlapArea::from_spec(s)?))
+            }
             ContactSpec::Continuous(s) => {
                 Ok(Self::Continuous(continuous::Continuous::from_spec(s, g)?))
             }
@@ -72,7 +78,7 @@ impl ContactLaw {
     /// Largest centre distance, in units of σ = (d1 + d2)/2, at which two disks interact.
     pub fn range_factor(&self) -> f64 {
         match self {
-            Self::SpringDashpot(_) => 1.0,
+            Self::SpringDashpot(_) | Self::OverlapArea(_) => 1.0,
             Self::Continuous(c) => c.range_factor(),
         }
     }
@@ -85,6 +91,7 @@ impl ContactLaw {
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         match self {
             Self::SpringDashpot(l) => l.evaluate(c),
+            Self::OverlapArea(l) => l.evaluate(c),
             Self::Continuous(l) => l.evaluate(c),
         }
     }
@@ -94,6 +101,7 @@ impl ContactLaw {
     pub fn omega0_squared(&self, m12: f64, sigma: f64) -> f64 {
         match self {
             Self::SpringDashpot(l) => l.omega0_squared(m12, sigma),
+            Self::OverlapArea(l) => l.omega0_squared(m12),
             Self::Continuous(l) => l.omega0_squared(m12, sigma),
         }
     }
@@ -101,6 +109,7 @@ impl ContactLaw {
     pub fn mu(&self) -> f64 {
         match self {
             Self::SpringDashpot(l) => l.mu,
+            Self::OverlapArea(l) => l.mu,
             Self::Continuous(l) => l.mu,
         }
     }

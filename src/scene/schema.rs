@@ -115,6 +115,7 @@ fn one() -> f64 {
 #[serde(tag = "law", rename_all = "snake_case")]
 pub enum ContactSpec {
     SpringDashpot(SpringDashpotSpec),
+    OverlapArea(OverlapAreaSpec),
     Continuous(ContinuousSpec),
     HookeEquivalent(HookeEquivalentSpec),
 }
@@ -154,6 +155,51 @@ pub struct SpringDashpotSpec {
 }
 
 /// Continuous r^-(n+1) interaction with tapered friction, paper 001 eq. 3–8.
+/// The overlap-area law of convex polygons, paper 000 eq. 6–7 (SPEC 2.3).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OverlapAreaSpec {
+    /// k^n [force/length]: f_el = k^n A/l.
+    pub k_n: f64,
+    /// Dimensionless normal damping η^n = γ^n/sqrt(m12 k^n).
+    #[serde(default)]
+    pub eta_n: f64,
+    #[serde(default)]
+    pub mu: f64,
+    /// k^t/k^n (paper: 2/7).
+    #[serde(default = "default_kt_ratio")]
+    pub kt_ratio: f64,
+    /// Dimensionless tangential damping η^t = γ^t/sqrt(m12 k^t) (paper: 0.01).
+    #[serde(default = "default_eta_t")]
+    pub eta_t: f64,
+}
+
+fn default_kt_ratio() -> f64 {
+    2.0 / 7.0
+}
+fn default_eta_t() -> f64 {
+    0.01
+}
+
+/// Convex polygons instead of disks (paper 000 sec. 2.2, 5): `corners` corners on an
+/// ellipse with full axes (a, b) at angles φ0 + 2πk/C. Without `axes` they are regular:
+/// in lists and point sources inscribed in the circle of the block's diameter; on
+/// lattice piles and rows the diameter is the face-to-face one and a face points along
+/// +x, so that lattice neighbours touch face to face (C divisible by 6).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolygonSpec {
+    pub corners: u32,
+    /// Full axes (a, b), each a fixed size or {"uniform": [lo, hi]}, drawn independently
+    /// (point sources only).
+    #[serde(default)]
+    pub axes: Option<[Size; 2]>,
+    /// Random start angle φ0 on the ellipse (irregular polygons, paper 000 sec. 5.4);
+    /// otherwise φ0 = 0.
+    #[serde(default)]
+    pub irregular: bool,
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContinuousSpec {
@@ -283,6 +329,9 @@ pub struct LatticePile {
     /// z of the bottom of the lowest row.
     #[serde(default)]
     pub base_z: f64,
+    /// Convex polygons instead of disks.
+    #[serde(default)]
+    pub polygon: Option<PolygonSpec>,
 }
 
 fn yes() -> bool {
@@ -302,6 +351,9 @@ pub struct Row {
     pub start: [f64; 2],
     #[serde(default = "yes")]
     pub fixed: bool,
+    /// Convex polygons instead of disks.
+    #[serde(default)]
+    pub polygon: Option<PolygonSpec>,
 }
 
 /// A point source pouring disks (paper 001 sec. II; paper 000 sec. 5.3).
@@ -318,12 +370,16 @@ pub struct PointSource {
     pub rate: f64,
     /// Total number to pour.
     pub count: u32,
-    pub diameter: Size,
+    #[serde(default)]
+    pub diameter: Option<Size>,
     /// Initial velocity (x, z).
     #[serde(default)]
     pub velocity: [f64; 2],
     #[serde(default)]
     pub start_time: f64,
+    /// Convex polygons instead of disks.
+    #[serde(default)]
+    pub polygon: Option<PolygonSpec>,
 }
 
 /// Particles given one by one (small test scenes).
@@ -332,6 +388,9 @@ pub struct PointSource {
 pub struct ParticleList {
     pub material: String,
     pub particles: Vec<ListedParticle>,
+    /// Convex polygons instead of disks.
+    #[serde(default)]
+    pub polygon: Option<PolygonSpec>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -2,7 +2,7 @@
 //! contact law's own parameters are checked where its coefficients are built
 //! (`ContactLaw::from_spec`).
 
-use super::{Creation, Scene, SceneError};
+use super::{ContactSpec, Creation, PolygonSpec, Scene, SceneError};
 use crate::law::ContactLaw;
 
 /// A contact must last at least this many steps; beyond t_c/10 only a warning (SPEC 3).
@@ -55,26 +55,94 @@ fn inside(scene: &Scene, path: &str, p: [f64; 2]) -> Result<(), SceneError> {
     }
 }
 
-/// Largest diameter any creation block can produce.
+/// Largest reach (diameter of the circumscribed circle) any creation block can produce:
+/// what the cell list needs.
 pub fn max_diameter(scene: &Scene) -> f64 {
     scene
         .particles
         .iter()
-        .map(|c| diameter_bounds(c).1)
+        .map(|c| reach_bounds(c).1)
         .fold(0.0, f64::max)
 }
 
-fn diameter_bounds(c: &Creation) -> (f64, f64) {
+/// The polygon spec of a block, if it makes polygons.
+pub fn polygon_of(c: &Creation) -> Option<&PolygonSpec> {
+    match c {
+        Creation::LatticePile(p) => p.polygon.as_ref(),
+        Creation::Row(r) => r.polygon.as_ref(),
+        Creation::PointSource(s) => s.polygon.as_ref(),
+        Creation::List(l) => l.polygon.as_ref(),
+    }
+}
+
+/// Smallest and largest full axes (or diameters) of a block's particles.
+fn size_bounds(c: &Creation) -> (f64, f64) {
     match c {
         Creation::LatticePile(p) => (
             p.diameter * (1.0 - 0.5 * p.size_disorder),
             p.diameter * (1.0 + 0.5 * p.size_disorder),
         ),
         Creation::Row(r) => (r.diameter, r.diameter),
-        Creation::PointSource(s) => s.diameter.bounds(),
+        Creation::PointSource(s) => match (&s.polygon, &s.diameter) {
+            (
+                Some(PolygonSpec {
+                    axes: Some([a, b]), ..
+                }),
+                _,
+            ) => {
+                let (a, b) = (a.bounds(), b.bounds());
+                (a.0.min(b.0), a.1.max(b.1))
+            }
+            (_, Some(d)) => d.bounds(),
+            (_, None) => (0.0, 0.0),
+        },
         Creation::List(l) => l.particles.iter().fold((f64::MAX, 0.0), |(lo, hi), p| {
             (lo.min(p.diameter), hi.max(p.diameter))
         }),
+    }
+}
+
+/// Diameter of the circumscribed circle, bounded over the block's sizes: a disk's
+/// diameter; a regular polygon's circle; for polygons on ellipses of independent axes
+/// the largest over the corners of the axes' ranges and the start angle, sampled finely,
+/// plus 2 % (the centroid of an irregular polygon is off the ellipse's centre).
+fn reach_bounds(c: &Creation) -> (f64, f64) {
+    let (lo, hi) = size_bounds(c);
+    let Some(p) = polygon_of(c) else {
+        return (lo, hi);
+    };
+    let Some([a, b]) = &p.axes else {
+        return match c {
+            // Face-to-face diameter on a lattice (create::regular_shape).
+            Creation::LatticePile(_) | Creation::Row(_) => {
+                let cos = (std::f64::consts::PI / p.corners as f64).cos();
+                (lo, hi / cos)
+            }
+            _ => (lo, hi),
+        };
+    };
+    let (a, b) = (a.bounds(), b.bounds());
+    let mut reach: f64 = 0.0;
+    for (x, z) in [(a.0, b.0), (a.0, b.1), (a.1, b.0), (a.1, b.1)] {
+        for k in 0..256 {
+            let start = std::f64::consts::TAU / p.corners.max(1) as f64 * k as f64 / 256.0;
+            let v = crate::shape::ellipse_polygon(p.corners, x, z, start);
+            reach = reach.max(2.0 * crate::shape::circumradius(&v));
+        }
+    }
+    (lo, 1.02 * reach)
+}
+
+/// Area of the smallest particle of a block: a disk, or a polygon on an ellipse with
+/// axes (a, b), which is the affine image of a regular polygon: (a b / 4)(C/2) sin(2π/C).
+fn smallest_area(c: &Creation) -> f64 {
+    let (lo, _) = size_bounds(c);
+    match polygon_of(c) {
+        None => std::f64::consts::PI * 0.25 * lo * lo,
+        Some(p) => {
+            let n = p.corners as f64;
+            0.25 * lo * lo * 0.5 * n * (std::f64::consts::TAU / n).sin()
+        }
     }
 }
 
@@ -96,9 +164,8 @@ fn lightest_mass(scene: &Scene) -> Option<f64> {
         .particles
         .iter()
         .filter_map(|c| {
-            let (d, _) = diameter_bounds(c);
             let m = scene.materials.get(material_of(c))?;
-            Some(m.density * std::f64::consts::PI * 0.25 * d * d * m.thickness)
+            Some(m.density * smallest_area(c) * m.thickness)
         })
         .reduce(f64::min)
 }
@@ -108,19 +175,61 @@ fn lightest_mass(scene: &Scene) -> Option<f64> {
 pub fn shortest_contact_time(scene: &Scene, law: &ContactLaw) -> Option<f64> {
     let mut best: Option<f64> = None;
     for c in &scene.particles {
-        let (d, _) = diameter_bounds(c);
+        let (d, _) = size_bounds(c);
         let Some(m) = scene.materials.get(material_of(c)) else {
             continue;
         };
         if !(d > 0.0 && d.is_finite()) {
             continue;
         }
-        let mass = m.density * std::f64::consts::PI * 0.25 * d * d * m.thickness;
+        let mass = m.density * smallest_area(c) * m.thickness;
         let w2 = law.omega0_squared(0.5 * mass, d);
         let tc = std::f64::consts::PI / w2.sqrt();
         best = Some(best.map_or(tc, |b: f64| b.min(tc)));
     }
     best
+}
+
+/// Polygon blocks: corner counts, axes only where sizes are drawn, and the contact law
+/// that goes with the shapes (disk–polygon contacts are not implemented yet).
+fn polygons(scene: &Scene) -> Result<(), SceneError> {
+    let area_law = matches!(scene.contact, ContactSpec::OverlapArea(_));
+    for (k, c) in scene.particles.iter().enumerate() {
+        let at = |key: &str| format!("particles[{k}].{key}");
+        match polygon_of(c) {
+            Some(p) => {
+                let (lo, hi) = (crate::shape::MIN_CORNERS, crate::shape::MAX_CORNERS);
+                if !(lo..=hi).contains(&p.corners) {
+                    return Err(SceneError::invalid(
+                        at("polygon.corners"),
+                        format!("must be in [{lo}, {hi}], got {}", p.corners),
+                    ));
+                }
+                if p.axes.is_some() && !matches!(c, Creation::PointSource(_)) {
+                    return Err(SceneError::invalid(
+                        at("polygon.axes"),
+                        "is only for point sources; other blocks make regular polygons of their diameter",
+                    ));
+                }
+                if !area_law {
+                    return Err(SceneError::invalid(
+                        "contact.law",
+                        format!(
+                            "particles[{k}] makes polygons, which need law \"overlap_area\" (paper 000 sec. 2.2)"
+                        ),
+                    ));
+                }
+            }
+            None if area_law => {
+                return Err(SceneError::invalid(
+                    at("polygon"),
+                    "is required: the overlap_area law is for polygons (disk–polygon contacts are not implemented yet)",
+                ));
+            }
+            None => {}
+        }
+    }
+    Ok(())
 }
 
 /// Checks every value; returns warnings that do not stop a run.
@@ -225,12 +334,33 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 finite_non_negative(&at("spread"), s.spread)?;
                 finite_positive(&at("rate"), s.rate)?;
                 finite_non_negative(&at("start_time"), s.start_time)?;
-                let (lo, hi) = s.diameter.bounds();
-                if !(lo > 0.0 && lo <= hi && hi.is_finite()) {
-                    return Err(SceneError::invalid(
-                        at("diameter"),
-                        format!("must be positive (and lo ≤ hi for a range), got {lo}..{hi}"),
-                    ));
+                let axes = s.polygon.as_ref().and_then(|p| p.axes.as_ref());
+                let sizes: Vec<(String, &crate::scene::Size)> = match (axes, &s.diameter) {
+                    (Some(_), Some(_)) => {
+                        return Err(SceneError::invalid(
+                            at("diameter"),
+                            "give either diameter or polygon.axes, not both",
+                        ));
+                    }
+                    (None, None) => {
+                        return Err(SceneError::invalid(
+                            at("diameter"),
+                            "is required (or polygon.axes for polygons on ellipses)",
+                        ));
+                    }
+                    (Some([a, b]), None) => {
+                        vec![(at("polygon.axes[0]"), a), (at("polygon.axes[1]"), b)]
+                    }
+                    (None, Some(d)) => vec![(at("diameter"), d)],
+                };
+                for (path, size) in sizes {
+                    let (lo, hi) = size.bounds();
+                    if !(lo > 0.0 && lo <= hi && hi.is_finite()) {
+                        return Err(SceneError::invalid(
+                            path,
+                            format!("must be positive (and lo ≤ hi for a range), got {lo}..{hi}"),
+                        ));
+                    }
                 }
             }
             Creation::List(l) => {
@@ -248,6 +378,7 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
             }
         }
     }
+    polygons(scene)?;
     let o = &scene.output;
     finite_non_negative("output.snapshot_every", o.snapshot_every)?;
     if let Some(c) = o.checkpoint_every {
