@@ -8,7 +8,7 @@
 
 use crate::cell_list::{CellList, Grid};
 use crate::geometry::{WallSegment, disk_disk, disk_wall};
-use crate::overlap::{polygon_polygon, polygon_wall};
+use crate::overlap::{overlap_area, polygon_wall};
 use crate::shape::WorldShapes;
 use crate::state::Particles;
 
@@ -44,7 +44,7 @@ pub fn interacts(
         return false;
     }
     if particles.is_polygon(i) {
-        return polygon_polygon(shapes.of(i), pi, shapes.of(j), pj).is_some();
+        return overlap_area(shapes.of(i), pi, shapes.of(j)) > 0.0;
     }
     true
 }

@@ -10,8 +10,46 @@
 //! n along the line of centres; more than two crossings (nearly parallel edges) take
 //! the two that are farthest apart, which spans the thin overlap along its length.
 
-use crate::geometry::{WallSegment, cross};
-use crate::shape::{P2, centroid};
+use crate::geometry::WallSegment;
+use crate::shape::{MAX_CORNERS, P2, centroid};
+
+/// Most corners an overlap polygon can have: each clipping half-plane adds at most one.
+pub const MAX_CLIP: usize = 2 * MAX_CORNERS as usize + 4;
+
+/// A convex polygon of at most [`MAX_CLIP`] corners, held on the stack (the overlap is
+/// computed for every contact every step; no allocation).
+#[derive(Clone, Copy, Debug)]
+pub struct Poly {
+    pub n: usize,
+    pub v: [P2; MAX_CLIP],
+}
+
+impl Default for Poly {
+    fn default() -> Self {
+        Self {
+            n: 0,
+            v: [[0.0; 2]; MAX_CLIP],
+        }
+    }
+}
+
+impl Poly {
+    pub fn from_slice(p: &[P2]) -> Self {
+        let mut out = Self::default();
+        out.v[..p.len()].copy_from_slice(p);
+        out.n = p.len();
+        out
+    }
+
+    pub fn corners(&self) -> &[P2] {
+        &self.v[..self.n]
+    }
+
+    fn push(&mut self, x: P2) {
+        self.v[self.n] = x;
+        self.n += 1;
+    }
+}
 
 /// The geometry of one area contact, seen from particle i.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -37,13 +75,13 @@ fn dot(a: P2, b: P2) -> f64 {
 }
 
 fn norm(a: P2) -> f64 {
-    a[0].hypot(a[1])
+    dot(a, a).sqrt()
 }
 
 /// One Sutherland–Hodgman step: the part of the convex polygon `poly` in the half-plane
 /// {x : (x − a)·m ≥ 0}.
-pub fn clip_half_plane(poly: &[P2], a: P2, m: P2, out: &mut Vec<P2>) {
-    out.clear();
+pub fn clip_half_plane(poly: &[P2], a: P2, m: P2, out: &mut Poly) {
+    out.n = 0;
     let n = poly.len();
     for k in 0..n {
         let (p, q) = (poly[k], poly[(k + 1) % n]);
@@ -59,51 +97,114 @@ pub fn clip_half_plane(poly: &[P2], a: P2, m: P2, out: &mut Vec<P2>) {
 }
 
 /// The overlap polygon of two convex, counter-clockwise polygons: p clipped by every
-/// edge of q.
-pub fn intersection(p: &[P2], q: &[P2]) -> Vec<P2> {
-    let mut cur = p.to_vec();
-    let mut next = Vec::with_capacity(p.len() + q.len());
-    let n = q.len();
-    for k in 0..n {
-        let (a, b) = (q[k], q[(k + 1) % n]);
-        // Inward normal of a counter-clockwise edge: the edge turned by +90°.
-        clip_half_plane(&cur, a, [-(b[1] - a[1]), b[0] - a[0]], &mut next);
-        std::mem::swap(&mut cur, &mut next);
-        if cur.is_empty() {
+/// edge of q (p's centre ci speeds it up; see `tagged_intersection`).
+pub fn intersection(p: &[P2], ci: P2, q: &[P2]) -> Poly {
+    tagged_intersection(p, ci, q).poly
+}
+
+/// Whether two convex polygons overlap with positive area (the contact test of the
+/// broad phase's survivors; the same clipping as [`polygon_polygon`]).
+pub fn overlap_area(p: &[P2], ci: P2, q: &[P2]) -> f64 {
+    let o = intersection(p, ci, q);
+    if o.n < 3 {
+        return 0.0;
+    }
+    crate::shape::area(o.corners())
+}
+
+/// Where a corner of the overlap polygon comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Origin {
+    /// A corner of p inside q.
+    P,
+    /// A corner of q inside p (two of q's edge lines meet).
+    Q,
+    /// An edge of p crosses an edge of q: a crossing point of the outlines.
+    Crossing,
+}
+
+/// The overlap polygon with the origin of each corner: p clipped by every edge of q,
+/// remembering for each edge of the clipped polygon whether it lies on p's outline. A
+/// new corner on such an edge is a crossing of the outlines; one on an edge of q's
+/// lines is a corner of q. The crossings come out of the clipping, with no extra search.
+struct Tagged {
+    poly: Poly,
+    origin: [Origin; MAX_CLIP],
+    on_p: [bool; MAX_CLIP],
+}
+
+impl Tagged {
+    fn push(&mut self, x: P2, origin: Origin, on_p: bool) {
+        let n = self.poly.n;
+        self.poly.v[n] = x;
+        self.origin[n] = origin;
+        self.on_p[n] = on_p;
+        self.poly.n += 1;
+    }
+}
+
+fn tagged_intersection(p: &[P2], ci: P2, q: &[P2]) -> Tagged {
+    let empty = || Tagged {
+        poly: Poly::default(),
+        origin: [Origin::P; MAX_CLIP],
+        on_p: [true; MAX_CLIP],
+    };
+    let mut buf = [empty(), empty()];
+    buf[0].poly = Poly::from_slice(p);
+    let mut cur = 0;
+    // p lies in the circle of radius r about ci: an edge line of q that keeps the whole
+    // circle inside clips nothing, one that keeps it all outside leaves no overlap. Only
+    // the few edges near the contact are clipped.
+    let r = p
+        .iter()
+        .map(|v| dot(sub(*v, ci), sub(*v, ci)))
+        .fold(0.0, f64::max)
+        .sqrt();
+    let nq = q.len();
+    for k in 0..nq {
+        let (a, b) = (q[k], q[(k + 1) % nq]);
+        let m = [-(b[1] - a[1]), b[0] - a[0]];
+        let reach = r * norm(m);
+        let centre = dot(sub(ci, a), m);
+        if centre >= reach {
+            continue;
+        }
+        if centre <= -reach {
+            buf[cur].poly.n = 0;
+            break;
+        }
+        let (src, dst) = if cur == 0 {
+            let (x, y) = buf.split_at_mut(1);
+            (&x[0], &mut y[0])
+        } else {
+            let (x, y) = buf.split_at_mut(1);
+            (&y[0], &mut x[0])
+        };
+        dst.poly.n = 0;
+        let n = src.poly.n;
+        for e in 0..n {
+            let (x, y) = (src.poly.v[e], src.poly.v[(e + 1) % n]);
+            let (dx, dy) = (dot(sub(x, a), m), dot(sub(y, a), m));
+            let on_p = src.on_p[e];
+            if dx >= 0.0 {
+                dst.push(x, src.origin[e], on_p);
+            }
+            if (dx >= 0.0) != (dy >= 0.0) {
+                let t = dx / (dx - dy);
+                let at = [x[0] + t * (y[0] - x[0]), x[1] + t * (y[1] - x[1])];
+                let origin = if on_p { Origin::Crossing } else { Origin::Q };
+                // Leaving the half-plane the polygon follows q's line; entering it, the
+                // edge it was on.
+                dst.push(at, origin, if dx >= 0.0 { false } else { on_p });
+            }
+        }
+        cur = 1 - cur;
+        if buf[cur].poly.n == 0 {
             break;
         }
     }
-    cur
-}
-
-/// Crossing points of the two outlines: intersections of an edge of p with an edge of q.
-/// Parameters are half-open, [0, 1) on both edges, so a crossing through a corner is
-/// found once.
-pub fn crossings(p: &[P2], q: &[P2], out: &mut Vec<P2>) {
-    out.clear();
-    let (np, nq) = (p.len(), q.len());
-    for a in 0..np {
-        let (p0, d) = (p[a], sub(p[(a + 1) % np], p[a]));
-        for b in 0..nq {
-            let (q0, e) = (q[b], sub(q[(b + 1) % nq], q[b]));
-            let den = cross(d, e);
-            if den == 0.0 {
-                continue; // parallel edges: their end points are found on the neighbours
-            }
-            let w = sub(q0, p0);
-            let t = cross(w, e) / den;
-            let s = cross(w, d) / den;
-            if (0.0..1.0).contains(&t) && (0.0..1.0).contains(&s) {
-                out.push([p0[0] + t * d[0], p0[1] + t * d[1]]);
-            }
-        }
-    }
-}
-
-/// Whether x lies inside the convex, counter-clockwise polygon q (boundary excluded).
-fn strictly_inside(x: P2, q: &[P2]) -> bool {
-    let n = q.len();
-    (0..n).all(|k| cross(sub(q[(k + 1) % n], q[k]), sub(x, q[k])) > 0.0)
+    let [a, b] = buf;
+    if cur == 0 { a } else { b }
 }
 
 /// The two points farthest apart.
@@ -132,16 +233,22 @@ fn reduced_arm(li: f64, lj: f64, scale: f64) -> f64 {
 /// cj), both convex and counter-clockwise in world coordinates; None when the outlines
 /// do not overlap.
 pub fn polygon_polygon(p: &[P2], ci: P2, q: &[P2], cj: P2) -> Option<AreaContact> {
-    let overlap = intersection(p, q);
-    if overlap.len() < 3 {
+    let tagged = tagged_intersection(p, ci, q);
+    if tagged.poly.n < 3 {
         return None;
     }
-    let area = crate::shape::area(&overlap);
+    let overlap = tagged.poly.corners();
+    let area = crate::shape::area(overlap);
     if area <= 0.0 {
         return None;
     }
-    let mut xs = Vec::with_capacity(4);
-    crossings(p, q, &mut xs);
+    let mut crossed = Poly::default();
+    for (k, x) in overlap.iter().enumerate() {
+        if tagged.origin[k] == Origin::Crossing {
+            crossed.push(*x);
+        }
+    }
+    let xs = crossed.corners();
     let scale = norm(sub(ci, cj)) + norm(sub(p[0], ci)) + norm(sub(q[0], cj));
     let centres = sub(ci, cj);
     let along_centres = if norm(centres) > 0.0 {
@@ -150,7 +257,7 @@ pub fn polygon_polygon(p: &[P2], ci: P2, q: &[P2], cj: P2) -> Option<AreaContact
         [0.0, 1.0]
     };
     let (n, point, chord) = if xs.len() >= 2 {
-        let (a, b) = farthest_pair(&xs);
+        let (a, b) = farthest_pair(xs);
         let chord = norm(sub(b, a));
         if chord > 1e-12 * scale {
             let t = [(b[0] - a[0]) / chord, (b[1] - a[1]) / chord];
@@ -158,24 +265,24 @@ pub fn polygon_polygon(p: &[P2], ci: P2, q: &[P2], cj: P2) -> Option<AreaContact
             let s = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
             // Corners of i inside j lie on j's side of the line, corners of j inside i
             // on i's side; n points from j to i.
-            let side: f64 = p
+            let side: f64 = overlap
                 .iter()
-                .filter(|v| strictly_inside(**v, q))
-                .map(|v| dot(n, sub(*v, s)))
-                .sum::<f64>()
-                - q.iter()
-                    .filter(|w| strictly_inside(**w, p))
-                    .map(|w| dot(n, sub(*w, s)))
-                    .sum::<f64>();
+                .enumerate()
+                .map(|(k, x)| match tagged.origin[k] {
+                    Origin::P => dot(n, sub(*x, s)),
+                    Origin::Q => -dot(n, sub(*x, s)),
+                    Origin::Crossing => 0.0,
+                })
+                .sum();
             if side > 0.0 || (side == 0.0 && dot(n, centres) < 0.0) {
                 n = [-n[0], -n[1]];
             }
             (n, s, chord)
         } else {
-            (along_centres, centroid(&overlap), 0.0)
+            (along_centres, centroid(overlap), 0.0)
         }
     } else {
-        (along_centres, centroid(&overlap), 0.0)
+        (along_centres, centroid(overlap), 0.0)
     };
     let l = reduced_arm(norm(sub(point, ci)), norm(sub(point, cj)), scale);
     Some(AreaContact {
@@ -201,15 +308,16 @@ pub fn polygon_wall(p: &[P2], ci: P2, w: &WallSegment) -> Option<AreaContact> {
     if dot(m, sub(ci, w.a)) < 0.0 {
         m = [-m[0], -m[1]];
     }
-    let mut cur = Vec::with_capacity(p.len() + 3);
-    let mut next = Vec::with_capacity(p.len() + 3);
+    let mut cur = Poly::default();
+    let mut next = Poly::default();
     clip_half_plane(p, w.a, [-m[0], -m[1]], &mut cur);
-    clip_half_plane(&cur, w.a, ab, &mut next);
-    clip_half_plane(&next, w.b, [-ab[0], -ab[1]], &mut cur);
-    if cur.len() < 3 {
+    clip_half_plane(cur.corners(), w.a, ab, &mut next);
+    clip_half_plane(next.corners(), w.b, [-ab[0], -ab[1]], &mut cur);
+    if cur.n < 3 {
         return None;
     }
-    let area = crate::shape::area(&cur);
+    let cur = cur.corners();
+    let area = crate::shape::area(cur);
     if area <= 0.0 {
         return None;
     }
@@ -227,7 +335,7 @@ pub fn polygon_wall(p: &[P2], ci: P2, w: &WallSegment) -> Option<AreaContact> {
         let s = 0.5 * (lo + hi) / len;
         ([w.a[0] + s * ab[0], w.a[1] + s * ab[1]], hi - lo)
     } else {
-        (centroid(&cur), 0.0)
+        (centroid(cur), 0.0)
     };
     let l = norm(sub(point, ci)).max(1e-9 * scale);
     Some(AreaContact {
