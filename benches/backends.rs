@@ -1,5 +1,6 @@
 //! `cargo bench --bench backends`: the `talus bench` workloads (settled packings of 10³,
-//! 10⁴ and 10⁵ disks and the reduced R4 pour) on the CPU and GPU paths, as JSON.
+//! 10⁴ and 10⁵ disks, lattice piles of 10³, 10⁴ and 5·10⁴ 12-gons, and the reduced R4
+//! pour) on the CPU and GPU paths, as JSON.
 //! Set TALUS_BENCH_SIZES=1000,10000 to choose sizes.
 
 use talus::gpu::device::BackendChoice;
@@ -15,7 +16,10 @@ fn main() {
     } else {
         eprintln!("no GPU adapter: measuring the CPU path only");
     }
-    match talus::bench::run(&backends, &sizes, 200, true, &mut |l| eprintln!("{l}")) {
+    let polygon_sizes = vec![1000, 10_000, 50_000];
+    match talus::bench::run(&backends, &sizes, &polygon_sizes, 200, true, &mut |l| {
+        eprintln!("{l}")
+    }) {
         Ok(r) => println!("{}", serde_json::to_string_pretty(&r).unwrap()),
         Err(e) => {
             eprintln!("error: {e}");

@@ -59,6 +59,9 @@ enum Command {
         /// Packing sizes (disks) of the settled-packing workloads.
         #[arg(long, value_delimiter = ',', default_values_t = [1000, 10000, 100000])]
         sizes: Vec<usize>,
+        /// Sizes (polygons) of the polygon-pile workloads (regular 12-gons).
+        #[arg(long, value_delimiter = ',', default_values_t = [1000, 10000, 50000])]
+        polygon_sizes: Vec<usize>,
         /// Steps timed per workload (after a warm-up of a tenth as many).
         #[arg(long, default_value_t = 200)]
         steps: u64,
@@ -108,10 +111,11 @@ pub fn main() -> ExitCode {
         Command::Bench {
             backend,
             sizes,
+            polygon_sizes,
             steps,
             pour,
             out,
-        } => cmd_bench(&backend, &sizes, steps, pour, out),
+        } => cmd_bench(&backend, &sizes, &polygon_sizes, steps, pour, out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -251,11 +255,12 @@ fn choose_engine(sim: Simulation, backend: Backend, quiet: bool) -> Result<Engin
 fn cmd_bench(
     backends: &[Backend],
     sizes: &[usize],
+    polygon_sizes: &[usize],
     steps: u64,
     pour: bool,
     out: Option<PathBuf>,
 ) -> Result<(), Failure> {
-    let report = bench::run(backends, sizes, steps, pour, &mut |line| {
+    let report = bench::run(backends, sizes, polygon_sizes, steps, pour, &mut |line| {
         eprintln!("{line}")
     })
     .map_err(|e| Failure {
