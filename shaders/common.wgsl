@@ -10,6 +10,10 @@ const WG: u32 = 64u;
 const MAX_CONTACTS: u32 = 16u;
 const WALL_BASE: u32 = 0xFFFF0000u;
 const EMPTY: u32 = 0xFFFFFFFFu;
+// Params.law
+const LAW_SPRING_DASHPOT: u32 = 0u;
+const LAW_CONTINUOUS: u32 = 1u;
+const LAW_AREA: u32 = 2u;
 // Props.flags
 const ACTIVE: u32 = 1u;
 const FIXED: u32 = 2u;
@@ -45,12 +49,13 @@ struct Params {
     gx: f32,
     gz: f32,
     ramp_steps: f32,   // gravity ramp in steps; 0: none
-    law: u32,          // 0 spring-dashpot, 1 continuous
+    law: u32,          // 0 spring-dashpot, 1 continuous, 2 overlap area (polygons)
     dom_lo_x: f32,     // domain, relative to the grid origin
     dom_lo_z: f32,
     dom_hi_x: f32,
     dom_hi_z: f32,
-    // spring-dashpot (paper 000 eq. 2-5)
+    // spring-dashpot (paper 000 eq. 2-5); the overlap-area law (paper 000 eq. 6-7)
+    // uses k_n, k_t, mu, and gamma_n, gamma_t for its dimensionless eta_n, eta_t
     k_n: f32,
     nu: f32,
     psi: f32,
@@ -93,7 +98,7 @@ struct Props {
     flags: u32,         // ACTIVE | FIXED | material << 8
     radius_units: u32,  // the radius in fixed point (position.wgsl)
     radius_rem: f32,
-    _pad: vec2<u32>,
+    shape: vec2<u32>,   // polygon corners: first index in `corners`, count (0: disk)
 };
 
 struct ContactOut {
@@ -141,7 +146,9 @@ struct Candidate {
     flags: u32,
     radius_units: u32,
     radius_rem: f32,
-    _pad: u32,
+    theta: f32,
+    shape: vec2<u32>,
+    _pad: vec2<u32>,
 };
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -164,6 +171,8 @@ struct Candidate {
 @group(0) @binding(17) var<storage, read_write> control: array<atomic<u32>>;
 @group(0) @binding(18) var<storage, read_write> sources: array<Source>;
 @group(0) @binding(19) var<storage, read_write> candidates: array<Candidate>;
+// Polygon corners in the body frame (counter-clockwise, centroid at the origin).
+@group(0) @binding(20) var<storage, read_write> corners: array<vec2<f32>>;
 // The spring table of the previous step (read) and of this step (written); the host
 // swaps the two buffers every step.
 @group(1) @binding(0) var<storage, read_write> table_old: array<Entry>;

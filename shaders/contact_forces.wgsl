@@ -23,17 +23,33 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         var m12 = m1;
         var mass = m1;
         let wall = j >= WALL_BASE;
-        if (wall) {
-            let w = j - WALL_BASE;
-            g = disk_wall(i, w);
-        } else {
+        if (!wall) {
             d_ij = offset_vector(offset_ij(i, j));
-            g = disk_disk(i, j);
             v2 = velocity(j);
             rmin = min(ri, props[j].radius);
             let m2 = props[j].mass;
             m12 = m1 * m2 / (m1 + m2);
             mass = 2.0 * m12;
+        }
+        // The law sees the rate of delta: the overlap's for disks, L v_n / l for the
+        // overlap area (delta = A/l; src/forces.rs `area_contact_input`).
+        var rate = 1.0;
+        if (POLYGONS) {
+            var a: AreaContact;
+            if (wall) { a = polygon_wall_iw(i, j - WALL_BASE, false); } else { a = polygons_ij(i, j, false); }
+            var delta = 0.0;
+            var depth = 0.0;
+            rate = 0.0;
+            if (a.found && a.l > 0.0) {
+                delta = a.area / a.l;
+                if (a.chord > 0.0) { depth = a.area / a.chord; }
+                rate = a.chord / a.l;
+            }
+            g = Geometry(a.n, delta, depth, 0.0, a.point, true);
+        } else if (wall) {
+            g = disk_wall(i, j - WALL_BASE);
+        } else {
+            g = disk_disk(i, j);
         }
         let l1 = g.arm;
         let l2 = d_ij + l1;
@@ -43,7 +59,7 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         // Relative velocity of the two surfaces at the contact point.
         let v12 = v1.xy + s1 - v2.xy - s2;
         let t = tangent(g.n);
-        let input = ContactInput(g.delta, g.r, g.sigma, -dot(v12, g.n), dot(v12, t),
+        let input = ContactInput(g.delta, g.r, g.sigma, -dot(v12, g.n) * rate, dot(v12, t),
                                  m12, mass, hist_in[slot], params.dt);
         let res = evaluate(input);
         let f = res.f_n * g.n + res.f_t * t;

@@ -28,5 +28,6 @@ fn correct(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = state[i];
     correct_one(&s, acceleration(i, g));
     renormalize(&s);
+    if (props[i].shape.y > 0u) { wrap_angle(&s); }
     state[i] = s;
 }

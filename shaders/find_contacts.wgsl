@@ -13,8 +13,20 @@ fn in_range(i: u32, j: u32) -> bool {
     let r2 = dot(v, v);
     let margin = 2.0e-5 * reach * reach;
     if (r2 > reach * reach + margin) { return false; }
+    // Polygons: inside the circumscribed circles, a contact is a positive overlap area.
+    if (POLYGONS) { return polygons_ij(i, j, true).found; }
     if (r2 < reach * reach - margin) { return true; }
     let g = disk_disk(i, j);
+    return g.r < params.range_factor * g.sigma;
+}
+
+fn touches_wall(i: u32, w: u32) -> bool {
+    let g = disk_wall(i, w);
+    if (POLYGONS) {
+        // The circumscribed circle first (with f32 slack), then the area.
+        if (g.delta < -1.0e-5 * props[i].radius) { return false; }
+        return polygon_wall_iw(i, w, true).found;
+    }
     return g.r < params.range_factor * g.sigma;
 }
 
@@ -51,8 +63,7 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     if (!fixed_i) {
         for (var w = 0u; w < params.n_walls; w++) {
-            let g = disk_wall(i, w);
-            if (g.r >= params.range_factor * g.sigma) { continue; }
+            if (!touches_wall(i, w)) { continue; }
             if (n == MAX_CONTACTS) { halt(HALT_CONTACTS_FULL, i); break; }
             found[n] = WALL_BASE + w;
             n++;

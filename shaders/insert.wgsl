@@ -51,7 +51,7 @@ fn insert_place() {
             }
             if (blocked) { continue; }
             var st: State;
-            st.q[0] = vec4<f32>(cand.rem, 0.0, 0.0);
+            st.q[0] = vec4<f32>(cand.rem, cand.theta, 0.0);
             st.q[1] = vec4<f32>(cand.velocity, 0.0, 0.0);
             if (params.integrator == 0u) {
                 // Gear starts with the gravitational acceleration in q2.
@@ -62,7 +62,7 @@ fn insert_place() {
             st.frac = cand.frac;
             state[n] = st;
             props[n] = Props(cand.radius, cand.mass, cand.inv_inertia, cand.flags,
-                             cand.radius_units, cand.radius_rem, vec2<u32>(0u));
+                             cand.radius_units, cand.radius_rem, cand.shape);
             atomicStore(&control[C_LIVE], n + 1u);
             sources[s].inserted = k + 1u;
         }

@@ -17,5 +17,6 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
     s.q[0].z += s.q[1].z;
     displace(&s, s.q[1].xy);
     renormalize(&s);
+    if (props[i].shape.y > 0u) { wrap_angle(&s); }
     state[i] = s;
 }

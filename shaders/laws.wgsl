@@ -137,7 +137,29 @@ fn continuous(c: ContactInput) -> ContactOutput {
     return ContactOutput(f_n, f_t, delta_f, energy);
 }
 
+// Overlap-area law of polygons, paper 000 eq. 6-7 (src/law/overlap_area.rs): delta is
+// A/l, r the depth A/L; eta_n and eta_t arrive in gamma_n and gamma_t.
+fn overlap_area(c: ContactInput) -> ContactOutput {
+    let gamma_n = params.gamma_n * sqrt(c.m12 * params.k_n);
+    let gamma_t = params.gamma_t * sqrt(c.m12 * params.k_t);
+    let f_el = params.k_n * c.delta;
+    let f_n = max(f_el + gamma_n * c.delta_dot, 0.0);
+    let xi = c.history + c.v_t * c.dt;
+    let trial = -params.k_t * xi - gamma_t * c.v_t;
+    let cap = params.mu * f_n;
+    var f_t = trial;
+    var xs = xi;
+    if (abs(trial) > cap) {
+        f_t = select(-cap, cap, trial >= 0.0);
+        xs = 0.0;
+        if (params.k_t > 0.0) { xs = -f_t / params.k_t; }
+    }
+    let energy = 0.5 * f_el * c.r + 0.5 * params.k_t * xs * xs;
+    return ContactOutput(f_n, f_t, xs, energy);
+}
+
 fn evaluate(c: ContactInput) -> ContactOutput {
-    if (params.law == 0u) { return spring_dashpot(c); }
+    if (params.law == LAW_SPRING_DASHPOT) { return spring_dashpot(c); }
+    if (params.law == LAW_AREA) { return overlap_area(c); }
     return continuous(c);
 }

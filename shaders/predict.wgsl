@@ -23,5 +23,6 @@ fn predict(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = state[i];
     predict_one(&s);
     renormalize(&s);
+    if (props[i].shape.y > 0u) { wrap_angle(&s); }
     state[i] = s;
 }

@@ -171,12 +171,6 @@ pub fn run(
             } else {
                 steps
             };
-            if name.starts_with("polygon") && b == BackendChoice::Gpu {
-                log(format!(
-                    "{name:>18} gpu: skipped, polygons are not on the GPU path yet"
-                ));
-                continue;
-            }
             let m = measure(name, sim, b, k)?;
             log(format!(
                 "{:>18} {:>28} {:>7} particles {:>10.3e} particle-steps/s",

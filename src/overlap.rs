@@ -6,12 +6,13 @@
 //! the normal is perpendicular to it, the tangent along it, and the force acts at its
 //! midpoint S. Degenerate overlaps fall back to quantities that stay finite and vary
 //! continuously with the area, which then is small: fewer than two crossings (one
-//! polygon inside the other) or a vanishing chord take S at the overlap's centroid and
-//! n along the line of centres; more than two crossings (nearly parallel edges) take
-//! the two that are farthest apart, which spans the thin overlap along its length.
+//! polygon inside the other) or a vanishing chord take S at the mean of the overlap's
+//! corners and n along the line of centres; more than two crossings (nearly parallel
+//! edges) take the two that are farthest apart, which spans the thin overlap along its
+//! length.
 
 use crate::geometry::WallSegment;
-use crate::shape::{MAX_CORNERS, P2, centroid};
+use crate::shape::{MAX_CORNERS, P2};
 
 /// Most corners an overlap polygon can have: each clipping half-plane adds at most one.
 pub const MAX_CLIP: usize = 2 * MAX_CORNERS as usize + 4;
@@ -207,6 +208,14 @@ fn tagged_intersection(p: &[P2], ci: P2, q: &[P2]) -> Tagged {
     if cur == 0 { a } else { b }
 }
 
+/// Mean of the corners: the fallback force point. Unlike the area centroid it needs no
+/// division by a vanishing area, so a degenerate overlap keeps S inside it.
+fn corner_mean(v: &[P2]) -> P2 {
+    let n = v.len() as f64;
+    let s = v.iter().fold([0.0, 0.0], |a, x| [a[0] + x[0], a[1] + x[1]]);
+    [s[0] / n, s[1] / n]
+}
+
 /// The two points farthest apart.
 fn farthest_pair(points: &[P2]) -> (P2, P2) {
     let mut best = (points[0], points[1], -1.0);
@@ -279,10 +288,10 @@ pub fn polygon_polygon(p: &[P2], ci: P2, q: &[P2], cj: P2) -> Option<AreaContact
             }
             (n, s, chord)
         } else {
-            (along_centres, centroid(overlap), 0.0)
+            (along_centres, corner_mean(overlap), 0.0)
         }
     } else {
-        (along_centres, centroid(overlap), 0.0)
+        (along_centres, corner_mean(overlap), 0.0)
     };
     let l = reduced_arm(norm(sub(point, ci)), norm(sub(point, cj)), scale);
     Some(AreaContact {
@@ -335,7 +344,7 @@ pub fn polygon_wall(p: &[P2], ci: P2, w: &WallSegment) -> Option<AreaContact> {
         let s = 0.5 * (lo + hi) / len;
         ([w.a[0] + s * ab[0], w.a[1] + s * ab[1]], hi - lo)
     } else {
-        (centroid(cur), 0.0)
+        (corner_mean(cur), 0.0)
     };
     let l = norm(sub(point, ci)).max(1e-9 * scale);
     Some(AreaContact {

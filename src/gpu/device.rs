@@ -16,7 +16,7 @@ pub enum BackendChoice {
 }
 
 /// Storage buffers bound at once by the largest kernel (see `shaders/common.wgsl`).
-pub const STORAGE_BUFFERS_NEEDED: u32 = 21;
+pub const STORAGE_BUFFERS_NEEDED: u32 = 22;
 
 #[derive(Debug, thiserror::Error)]
 pub enum DeviceError {

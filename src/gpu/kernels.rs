@@ -11,6 +11,7 @@ pub struct ModuleSource {
 const COMMON: &str = include_str!("../../shaders/common.wgsl");
 const POSITION: &str = include_str!("../../shaders/position.wgsl");
 const GEOMETRY: &str = include_str!("../../shaders/geometry.wgsl");
+const POLYGON: &str = include_str!("../../shaders/polygon.wgsl");
 const LAWS: &str = include_str!("../../shaders/laws.wgsl");
 
 pub const MODULES: &[ModuleSource] = &[
@@ -56,6 +57,7 @@ pub const MODULES: &[ModuleSource] = &[
             COMMON,
             POSITION,
             GEOMETRY,
+            POLYGON,
             include_str!("../../shaders/find_contacts.wgsl"),
         ],
     },
@@ -73,6 +75,7 @@ pub const MODULES: &[ModuleSource] = &[
             COMMON,
             POSITION,
             GEOMETRY,
+            POLYGON,
             LAWS,
             include_str!("../../shaders/contact_forces.wgsl"),
         ],
@@ -207,7 +210,7 @@ impl Kernel {
 }
 
 /// Storage bindings of group 0 (binding 0 is the uniform Params) and of group 1.
-pub const GROUP0_STORAGE: u32 = 19;
+pub const GROUP0_STORAGE: u32 = 20;
 pub const GROUP1_STORAGE: u32 = 2;
 
 fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
@@ -230,7 +233,9 @@ pub struct Pipelines {
 }
 
 impl Pipelines {
-    pub fn new(device: &wgpu::Device) -> Self {
+    /// `polygons`: build the contact kernels with their polygon branches
+    /// (`POLYGONS` in polygon.wgsl).
+    pub fn new(device: &wgpu::Device, polygons: bool) -> Self {
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
             binding: 0,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -269,12 +274,20 @@ impl Pipelines {
             .iter()
             .map(|&k| {
                 let (module, entry) = k.entry();
+                let flag = [("POLYGONS", if polygons { 1.0 } else { 0.0 })];
+                let constants: &[(&str, f64)] = match module {
+                    "find_contacts" | "contact_forces" => &flag,
+                    _ => &[],
+                };
                 let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(entry),
                     layout: Some(&layout),
                     module: &modules[module],
                     entry_point: Some(entry),
-                    compilation_options: Default::default(),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants,
+                        ..Default::default()
+                    },
                     cache: None,
                 });
                 (k, p)

@@ -101,7 +101,8 @@ pub struct Props {
     /// The radius in fixed point: `radius_units + radius_rem` units.
     pub radius_units: u32,
     pub radius_rem: f32,
-    pub _pad: [u32; 2],
+    /// Polygon corners: first index into the corner buffer and count (0 for a disk).
+    pub shape: [u32; 2],
 }
 
 #[repr(C)]
@@ -158,7 +159,10 @@ pub struct Candidate {
     pub flags: u32,
     pub radius_units: u32,
     pub radius_rem: f32,
-    pub _pad: u32,
+    /// Orientation and polygon corners (see `Props::shape`).
+    pub theta: f32,
+    pub shape: [u32; 2],
+    pub _pad: [u32; 2],
 }
 
 /// Field offsets of each struct, by WGSL member name, for the layout test.
@@ -229,7 +233,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 flags,
                 radius_units,
                 radius_rem,
-                _pad
+                shape
             ]
         ),
         fields!(ContactOut, "ContactOut", [ft, info]),
@@ -255,6 +259,8 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 flags,
                 radius_units,
                 radius_rem,
+                theta,
+                shape,
                 _pad
             ]
         ),

@@ -57,6 +57,7 @@ struct Buffers {
     control: wgpu::Buffer,
     sources: wgpu::Buffer,
     candidates: wgpu::Buffer,
+    corners: wgpu::Buffer,
     tables: [wgpu::Buffer; 2],
 }
 
@@ -80,6 +81,8 @@ pub struct GpuSimulation {
     pub params: Params,
     n_cap: u32,
     origin: [f64; 2],
+    /// The corners in the device's corner buffer, in f64 (shapes of downloaded particles).
+    corner_table: Vec<[f64; 2]>,
     sources: Vec<SourceBase>,
     /// Loss count at upload (the GPU counts from there), inactive particles at upload,
     /// and losses on the device after the last submission.
@@ -122,11 +125,6 @@ impl GpuSimulation {
     }
 
     pub fn with_gpu(mut sim: Simulation, gpu: Gpu) -> Result<Self, GpuError> {
-        if matches!(sim.law, ContactLaw::OverlapArea(_)) {
-            return Err(GpuError::Unsupported(
-                "polygons are not on the GPU path yet".into(),
-            ));
-        }
         let device_state = sim.device_state.take();
         let grid = sim.grid.clone();
         let cells = grid.cell_count() as u64;
@@ -161,6 +159,9 @@ impl GpuSimulation {
         let mut sources = Vec::new();
         let mut source_rows = Vec::new();
         let mut candidates = Vec::new();
+        // Polygon corners: every particle's in id order, then every candidate's.
+        let mut corner_table: Vec<[f64; 2]> =
+            sim.particles.shape.iter().flatten().copied().collect();
         let dt = sim.dt();
         for (spec, st) in specs.iter().zip(&sim.sources) {
             let list = source::upcoming(spec, st);
@@ -180,6 +181,8 @@ impl GpuSimulation {
                     position::split2(x - origin[0], spec.position[1] - origin[1], cell_size);
                 let (radius_units, radius_rem) = position::length_units(one.radius[0], cell_size);
                 let due = source::due_step(source::due_time(spec, st.inserted + k as u32), dt);
+                let shape = [corner_table.len() as u32, one.shape[0].len() as u32];
+                corner_table.extend_from_slice(&one.shape[0]);
                 candidates.push(Candidate {
                     anchor,
                     frac,
@@ -195,7 +198,9 @@ impl GpuSimulation {
                     flags: ACTIVE | (material << 8),
                     radius_units,
                     radius_rem,
-                    _pad: 0,
+                    theta: drawn.theta as f32,
+                    shape,
+                    _pad: [0; 2],
                 });
             }
             sources.push(SourceBase {
@@ -305,7 +310,13 @@ impl GpuSimulation {
         control[control::HALT_ID] = u32::MAX;
 
         let (states, props, entries) = match device_state {
-            Some(ds) => (ds.states, ds.props, ds.springs),
+            Some(mut ds) => {
+                // The corner buffer is laid out afresh: point each particle at its corners.
+                for (pr, start) in ds.props.iter_mut().zip(corner_starts(&sim.particles)) {
+                    pr.shape[0] = start;
+                }
+                (ds.states, ds.props, ds.springs)
+            }
             None => {
                 let (s, p) = to_device(&sim.particles, origin, cell_size);
                 let e = sim
@@ -352,12 +363,21 @@ impl GpuSimulation {
             control: init("control", bytemuck::cast_slice(&control)),
             sources: init("sources", bytemuck::cast_slice(&source_rows)),
             candidates: init("candidates", bytemuck::cast_slice(&candidates)),
+            corners: init(
+                "corners",
+                bytemuck::cast_slice(
+                    &corner_table
+                        .iter()
+                        .map(|v| [v[0] as f32, v[1] as f32])
+                        .collect::<Vec<[f32; 2]>>(),
+                ),
+            ),
             tables: [
                 init("springs 0", bytemuck::cast_slice(&table)),
                 init("springs 1", bytemuck::cast_slice(&table)),
             ],
         };
-        let pipelines = Pipelines::new(dev);
+        let pipelines = Pipelines::new(dev, matches!(sim.law, ContactLaw::OverlapArea(_)));
         let b = &buffers;
         let group0_buffers = [
             &b.params,
@@ -380,6 +400,7 @@ impl GpuSimulation {
             &b.control,
             &b.sources,
             &b.candidates,
+            &b.corners,
         ];
         let entries0: Vec<_> = group0_buffers
             .iter()
@@ -425,6 +446,7 @@ impl GpuSimulation {
             params,
             n_cap,
             origin,
+            corner_table,
             sources,
             lost_base,
             inactive_at_upload,
@@ -693,7 +715,7 @@ impl GpuSimulation {
         self.live = live as u32;
         let ds = self.device_state();
         let cell = self.params.cell_size;
-        let p = from_device(&ds.states, &ds.props, self.origin, cell);
+        let p = from_device(&ds.states, &ds.props, self.origin, cell, &self.corner_table);
         self.sim.particles = p;
         self.sim.step = self.step;
         self.sim.lost = self.lost_base + c[control::LOST] as u64;
@@ -847,9 +869,22 @@ impl GpuSimulation {
 }
 
 /// Host f64 particles → device layout.
+/// Where each particle's corners start in the corner buffer: particles in id order.
+pub fn corner_starts(p: &Particles) -> Vec<u32> {
+    p.shape
+        .iter()
+        .scan(0u32, |next, c| {
+            let start = *next;
+            *next += c.len() as u32;
+            Some(start)
+        })
+        .collect()
+}
+
 pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec<Props>) {
     let mut states = Vec::with_capacity(p.len());
     let mut props = Vec::with_capacity(p.len());
+    let starts = corner_starts(p);
     for i in 0..p.len() {
         let q0 = p.q[0][i];
         let (anchor, frac, rem) = position::split2(q0[0] - origin[0], q0[1] - origin[1], cell);
@@ -874,14 +909,20 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
             flags,
             radius_units,
             radius_rem,
-            _pad: [0; 2],
+            shape: [starts[i], p.shape[i].len() as u32],
         });
     }
     (states, props)
 }
 
 /// Device layout → host f64 particles.
-pub fn from_device(states: &[State], props: &[Props], origin: [f64; 2], cell: f32) -> Particles {
+pub fn from_device(
+    states: &[State],
+    props: &[Props],
+    origin: [f64; 2],
+    cell: f32,
+    corner_table: &[[f64; 2]],
+) -> Particles {
     let mut p = Particles::default();
     for (s, pr) in states.iter().zip(props) {
         let coord = |k: usize| {
@@ -908,7 +949,9 @@ pub fn from_device(states: &[State], props: &[Props], origin: [f64; 2], cell: f3
         p.fixed.push(pr.flags & FIXED != 0);
         p.active.push(pr.flags & ACTIVE != 0);
         p.material.push(pr.flags >> 8);
-        p.shape.push(Vec::new()); // the GPU path runs disks only
+        let [start, count] = pr.shape;
+        p.shape
+            .push(corner_table[start as usize..(start + count) as usize].to_vec());
     }
     p
 }
@@ -963,7 +1006,16 @@ fn law_params(law: &ContactLaw, p: &mut Params) {
             p.mu = l.mu as f32;
             p.clamp = l.clamp as u32;
         }
-        ContactLaw::OverlapArea(_) => unreachable!("refused in GpuSimulation::with_gpu"),
+        ContactLaw::OverlapArea(l) => {
+            // η^n and η^t travel in gamma_n and gamma_t (common.wgsl).
+            p.law = 2;
+            p.k_n = l.k_n as f32;
+            p.k_t = l.k_t as f32;
+            p.mu = l.mu as f32;
+            p.gamma_n = l.eta_n as f32;
+            p.gamma_t = l.eta_t as f32;
+            p.clamp = 1;
+        }
         ContactLaw::Continuous(c) => {
             p.law = 1;
             match c.elastic {
