@@ -40,7 +40,8 @@ pub fn interacts(
     let pos = &particles.q[0];
     let (pi, pj) = ([pos[i][0], pos[i][1]], [pos[j][0], pos[j][1]]);
     let g = disk_disk(pi, particles.radius[i], pj, particles.radius[j]);
-    if !(g.r < range_factor * g.sigma) {
+    // A NaN distance (a diverged state) interacts with nothing.
+    if g.r.is_nan() || g.r >= range_factor * g.sigma {
         return false;
     }
     if particles.is_polygon(i) {
@@ -59,7 +60,8 @@ pub fn touches_wall(
 ) -> bool {
     let pi = particles.position(i);
     let g = disk_wall(pi, particles.radius[i], wall);
-    if !(g.r < range_factor * g.sigma) {
+    // A NaN distance (a diverged state) interacts with nothing.
+    if g.r.is_nan() || g.r >= range_factor * g.sigma {
         return false;
     }
     if particles.is_polygon(i) {

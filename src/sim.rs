@@ -166,14 +166,9 @@ impl Simulation {
             && self.time() >= self.scene.gravity.ramp_time
     }
 
-    /// Starts Gear with the true initial acceleration in q2, (F/m + g) dt²/2 from the
-    /// contact forces of the initial configuration: free flight is exact from the first
-    /// step, and a packing created at rest in its equilibrium stays there instead of
-    /// starting with a kick of g dt²/2.
-    fn seed_accelerations(&mut self) {
-        if self.scene.integrator != IntegratorKind::Gear5 {
-            return;
-        }
+    /// Stages 2–8 at the current (predicted) state: cell list, world shapes, contacts,
+    /// their springs from the previous step, and every contact's force.
+    fn evaluate_contacts(&mut self) {
         self.cells
             .build(&self.grid, &self.particles.q[0], &self.particles.active);
         world_shapes(&self.particles, &mut self.shapes);
@@ -198,6 +193,17 @@ impl Simulation {
             &mut self.contacts,
             &mut self.history_out,
         );
+    }
+
+    /// Starts Gear with the true initial acceleration in q2, (F/m + g) dt²/2 from the
+    /// contact forces of the initial configuration: free flight is exact from the first
+    /// step, and a packing created at rest in its equilibrium stays there instead of
+    /// starting with a kick of g dt²/2.
+    fn seed_accelerations(&mut self) {
+        if self.scene.integrator != IntegratorKind::Gear5 {
+            return;
+        }
+        self.evaluate_contacts();
         reduce_forces(
             &self.particles,
             &self.pairs,
@@ -232,30 +238,7 @@ impl Simulation {
         if gear {
             gear::predict(&mut self.particles);
         }
-        self.cells
-            .build(&self.grid, &self.particles.q[0], &self.particles.active);
-        world_shapes(&self.particles, &mut self.shapes);
-        find_contacts(
-            &self.grid,
-            &self.cells,
-            &self.particles,
-            &self.shapes,
-            &self.walls,
-            self.law.range_factor(),
-            &mut self.pairs,
-        );
-        gather_history(&self.springs, &self.pairs, &mut self.history_in);
-        contact_forces(
-            &self.particles,
-            &self.shapes,
-            &self.walls,
-            &self.law,
-            dt,
-            &self.pairs,
-            &self.history_in,
-            &mut self.contacts,
-            &mut self.history_out,
-        );
+        self.evaluate_contacts();
         self.check_divergence()?;
         store_history(&self.pairs, &self.history_out, &mut self.springs);
         reduce_forces(
