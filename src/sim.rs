@@ -85,12 +85,9 @@ impl Simulation {
     pub fn new(scene: Scene) -> Result<Self, SceneError> {
         let mut rng = Rng::new(scene.seed);
         let particles = create::initial_particles(&scene, &mut rng);
-        let sources = scene
-            .particles
-            .iter()
-            .filter(|c| matches!(c, Creation::PointSource(_)))
-            .enumerate()
-            .map(|(k, _)| SourceState::new(scene.seed, k))
+        // Point sources first (the GPU path indexes them so), then layered blocks.
+        let sources = (0..source_count(&scene))
+            .map(|k| SourceState::new(scene.seed, k))
             .collect();
         let mut sim =
             Self::from_parts(scene, particles, SpringTable::default(), sources, rng, 0, 0)?;
@@ -110,6 +107,16 @@ impl Simulation {
     ) -> Result<Self, SceneError> {
         let g = scene.gravity.g;
         let law = ContactLaw::from_spec(&scene.contact, (g[0] * g[0] + g[1] * g[1]).sqrt())?;
+        if sources.len() != source_count(&scene) {
+            return Err(SceneError::invalid(
+                "particles",
+                format!(
+                    "the state has {} source states for {} point sources and layered blocks",
+                    sources.len(),
+                    source_count(&scene)
+                ),
+            ));
+        }
         let walls = scene
             .walls
             .iter()
@@ -156,13 +163,19 @@ impl Simulation {
         [g[0] * s, g[1] * s]
     }
 
-    /// Whether every source has poured all its particles and gravity is at full strength.
+    /// Whether every source has poured all its particles, every layered block has laid
+    /// all its rows, and gravity is at full strength.
     pub fn feeding_done(&self) -> bool {
-        let specs = self.scene.particles.iter().filter_map(|c| match c {
-            Creation::PointSource(s) => Some(s),
-            _ => None,
-        });
-        specs.zip(&self.sources).all(|(spec, st)| st.done(spec))
+        let (sources, layered) = creators(&self.scene);
+        let p = sources.len();
+        sources
+            .iter()
+            .zip(&self.sources)
+            .all(|(spec, st)| st.done(spec))
+            && layered
+                .iter()
+                .zip(&self.sources[p..])
+                .all(|(spec, st)| st.inserted >= create::layered::row_count(spec))
             && self.time() >= self.scene.gravity.ramp_time
     }
 
@@ -261,23 +274,42 @@ impl Simulation {
     }
 
     fn insert_from_sources(&mut self, t: f64) {
-        let mut k = 0;
-        for block in &self.scene.particles {
-            let Creation::PointSource(spec) = block else {
-                continue;
-            };
+        let (sources, layered) = creators(&self.scene);
+        let mut new = Vec::new();
+        for (k, spec) in sources.iter().enumerate() {
             let material = create::material_index(&self.scene, &spec.material);
-            let disks =
-                create::source::emit(spec, &mut self.sources[k], t, material, &self.particles);
-            for d in disks {
-                let id = create::push(&self.scene, &mut self.particles, &d) as usize;
-                let h = 0.5 * self.scene.dt * self.scene.dt;
-                if self.scene.integrator == IntegratorKind::Gear5 {
-                    let g = self.gravity(t);
-                    self.particles.q[2][id] = [h * g[0], h * g[1], 0.0];
-                }
+            new.extend(create::source::emit(
+                spec,
+                &mut self.sources[k],
+                t,
+                material,
+                &self.particles,
+            ));
+            self.push_new(&mut new, t);
+        }
+        for (m, spec) in layered.iter().enumerate() {
+            let material = create::material_index(&self.scene, &spec.material);
+            let k = sources.len() + m;
+            new.extend(create::layered::emit(
+                spec,
+                &mut self.sources[k],
+                t,
+                material,
+                &self.particles,
+            ));
+            self.push_new(&mut new, t);
+        }
+    }
+
+    /// Adds created particles; Gear starts them with the gravitational acceleration.
+    fn push_new(&mut self, new: &mut Vec<create::NewParticle>, t: f64) {
+        for d in new.drain(..) {
+            let id = create::push(&self.scene, &mut self.particles, &d) as usize;
+            let h = 0.5 * self.scene.dt * self.scene.dt;
+            if self.scene.integrator == IntegratorKind::Gear5 {
+                let g = self.gravity(t);
+                self.particles.q[2][id] = [h * g[0], h * g[1], 0.0];
             }
-            k += 1;
         }
     }
 
@@ -358,4 +390,24 @@ impl Simulation {
         e.elastic = self.contacts.iter().map(|c| c.energy).sum();
         e
     }
+}
+
+/// The point sources and the layered blocks of a scene, each in block order.
+pub fn creators(scene: &Scene) -> (Vec<crate::scene::PointSource>, Vec<crate::scene::Layered>) {
+    let mut sources = Vec::new();
+    let mut layered = Vec::new();
+    for c in &scene.particles {
+        match c {
+            Creation::PointSource(s) => sources.push(s.clone()),
+            Creation::Layered(l) => layered.push(l.clone()),
+            _ => {}
+        }
+    }
+    (sources, layered)
+}
+
+/// How many source states a scene has: its point sources, then its layered blocks.
+fn source_count(scene: &Scene) -> usize {
+    let (s, l) = creators(scene);
+    s.len() + l.len()
 }

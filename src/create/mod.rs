@@ -2,12 +2,14 @@
 //! explicit lists at the start, and point sources during the run.
 
 pub mod lattice;
+pub mod layered;
 pub mod source;
 
 use crate::rng::Rng;
 use crate::scene::{Creation, PolygonSpec, Scene};
 use crate::shape::{self, P2};
-use crate::state::{NewParticle, Particles};
+pub use crate::state::NewParticle;
+use crate::state::Particles;
 
 /// Index of each material name (in the scene's sorted order).
 pub fn material_index(scene: &Scene, name: &str) -> u32 {
@@ -109,7 +111,7 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
                     push(scene, &mut particles, &d);
                 }
             }
-            Creation::PointSource(_) => {}
+            Creation::PointSource(_) | Creation::Layered(_) => {}
         }
     }
     particles

@@ -106,7 +106,17 @@ fn size(s: &Size, rng: &mut Rng) -> f64 {
 /// [0, 2π/C) and [0, 2π).
 fn draw(spec: &PointSource, rng: &mut Rng) -> Drawn {
     let x = spec.position[0] + rng.range(-spec.spread, spec.spread);
-    let axes = match (&spec.polygon, &spec.diameter) {
+    draw_shape(x, spec.diameter.as_ref(), spec.polygon.as_ref(), rng)
+}
+
+/// The size and shape part of [`draw`] (also used by layered construction).
+pub fn draw_shape(
+    x: f64,
+    diameter: Option<&Size>,
+    polygon: Option<&crate::scene::PolygonSpec>,
+    rng: &mut Rng,
+) -> Drawn {
+    let axes = match (polygon, diameter) {
         (
             Some(crate::scene::PolygonSpec {
                 axes: Some([a, b]), ..
@@ -123,7 +133,7 @@ fn draw(spec: &PointSource, rng: &mut Rng) -> Drawn {
         (_, None) => unreachable!("validated: a point source has a diameter or polygon axes"),
     };
     let (mut start, mut theta) = (0.0, 0.0);
-    if let Some(p) = &spec.polygon {
+    if let Some(p) = polygon {
         if p.irregular {
             start = rng.range(0.0, std::f64::consts::TAU / p.corners as f64);
         }
@@ -139,11 +149,28 @@ fn draw(spec: &PointSource, rng: &mut Rng) -> Drawn {
 
 /// The particle a drawn candidate becomes (at the outlet, not yet placed).
 pub fn particle(spec: &PointSource, c: &Drawn, material: u32) -> NewParticle {
-    let (radius, corners) = super::shape_of(spec.polygon.as_ref(), c.axes[0], c.axes[1], c.start);
+    particle_at(
+        spec.polygon.as_ref(),
+        c,
+        [c.x, spec.position[1]],
+        spec.velocity,
+        material,
+    )
+}
+
+/// The particle a drawn candidate becomes at `position`.
+pub fn particle_at(
+    polygon: Option<&crate::scene::PolygonSpec>,
+    c: &Drawn,
+    position: [f64; 2],
+    velocity: [f64; 2],
+    material: u32,
+) -> NewParticle {
+    let (radius, corners) = super::shape_of(polygon, c.axes[0], c.axes[1], c.start);
     NewParticle {
-        position: [c.x, spec.position[1]],
+        position,
         theta: c.theta,
-        velocity: spec.velocity,
+        velocity,
         omega: 0.0,
         radius,
         fixed: false,

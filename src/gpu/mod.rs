@@ -125,6 +125,16 @@ impl GpuSimulation {
     }
 
     pub fn with_gpu(mut sim: Simulation, gpu: Gpu) -> Result<Self, GpuError> {
+        if sim
+            .scene
+            .particles
+            .iter()
+            .any(|c| matches!(c, Creation::Layered(_)))
+        {
+            return Err(GpuError::Unsupported(
+                "layer-by-layer creation is not on the GPU path yet".into(),
+            ));
+        }
         let device_state = sim.device_state.take();
         let grid = sim.grid.clone();
         let cells = grid.cell_count() as u64;

@@ -299,6 +299,7 @@ pub enum Creation {
     LatticePile(LatticePile),
     Row(Row),
     PointSource(PointSource),
+    Layered(Layered),
     List(ParticleList),
 }
 
@@ -354,6 +355,43 @@ pub struct Row {
     /// Convex polygons instead of disks.
     #[serde(default)]
     pub polygon: Option<PolygonSpec>,
+}
+
+/// Layer-by-layer construction (paper 000 sec. 5.4.2): every `interval` a row of
+/// particles is dropped from `gap` (in units of the largest particle) above the surface
+/// below each of them; each row is narrower than the one before, by 2 h / tan(slope) with
+/// h = (√3/2) d_max, so that the pile grows with the given outline. Rows stop when
+/// narrower than one particle. Particles are drawn as by a point source.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Layered {
+    pub material: String,
+    /// Disk diameter, or the circle of regular polygons; absent with `polygon.axes`.
+    #[serde(default)]
+    pub diameter: Option<Size>,
+    /// Convex polygons instead of disks.
+    #[serde(default)]
+    pub polygon: Option<PolygonSpec>,
+    /// x of the pile's centre line and z of its floor.
+    #[serde(default)]
+    pub center_x: f64,
+    #[serde(default)]
+    pub base_z: f64,
+    /// Width of the first row.
+    pub base_width: f64,
+    /// Angle of the outline, degrees.
+    pub slope: f64,
+    /// Time between rows.
+    pub interval: f64,
+    /// Drop height above the surface, in units of the largest particle (< 1: "smoothly").
+    #[serde(default = "default_gap")]
+    pub gap: f64,
+    #[serde(default)]
+    pub start_time: f64,
+}
+
+fn default_gap() -> f64 {
+    0.5
 }
 
 /// A point source pouring disks (paper 001 sec. II; paper 000 sec. 5.3).

@@ -2,7 +2,7 @@
 //! contact law's own parameters are checked where its coefficients are built
 //! (`ContactLaw::from_spec`).
 
-use super::{ContactSpec, Creation, PolygonSpec, Scene, SceneError};
+use super::{ContactSpec, Creation, PolygonSpec, Scene, SceneError, Size};
 use crate::law::ContactLaw;
 
 /// A contact must last at least this many steps; beyond t_c/10 only a warning (SPEC 3).
@@ -71,55 +71,30 @@ pub fn polygon_of(c: &Creation) -> Option<&PolygonSpec> {
         Creation::LatticePile(p) => p.polygon.as_ref(),
         Creation::Row(r) => r.polygon.as_ref(),
         Creation::PointSource(s) => s.polygon.as_ref(),
+        Creation::Layered(s) => s.polygon.as_ref(),
         Creation::List(l) => l.polygon.as_ref(),
     }
 }
 
-/// Smallest and largest full axes (or diameters) of a block's particles.
-fn size_bounds(c: &Creation) -> (f64, f64) {
-    match c {
-        Creation::LatticePile(p) => (
-            p.diameter * (1.0 - 0.5 * p.size_disorder),
-            p.diameter * (1.0 + 0.5 * p.size_disorder),
-        ),
-        Creation::Row(r) => (r.diameter, r.diameter),
-        Creation::PointSource(s) => match (&s.polygon, &s.diameter) {
-            (
-                Some(PolygonSpec {
-                    axes: Some([a, b]), ..
-                }),
-                _,
-            ) => {
-                let (a, b) = (a.bounds(), b.bounds());
-                (a.0.min(b.0), a.1.max(b.1))
-            }
-            (_, Some(d)) => d.bounds(),
-            (_, None) => (0.0, 0.0),
-        },
-        Creation::List(l) => l.particles.iter().fold((f64::MAX, 0.0), |(lo, hi), p| {
-            (lo.min(p.diameter), hi.max(p.diameter))
-        }),
+/// Size bounds of particles drawn from `diameter` or `polygon.axes` (sources, layers).
+fn drawn_size_bounds(diameter: Option<&Size>, polygon: Option<&PolygonSpec>) -> (f64, f64) {
+    match (polygon.and_then(|p| p.axes.as_ref()), diameter) {
+        (Some([a, b]), _) => {
+            let (a, b) = (a.bounds(), b.bounds());
+            (a.0.min(b.0), a.1.max(b.1))
+        }
+        (None, Some(d)) => d.bounds(),
+        (None, None) => (0.0, 0.0),
     }
 }
 
-/// Diameter of the circumscribed circle, bounded over the block's sizes: a disk's
-/// diameter; a regular polygon's circle; for polygons on ellipses of independent axes
-/// the largest over the corners of the axes' ranges and the start angle, sampled finely,
-/// plus 2 % (the centroid of an irregular polygon is off the ellipse's centre).
-fn reach_bounds(c: &Creation) -> (f64, f64) {
-    let (lo, hi) = size_bounds(c);
-    let Some(p) = polygon_of(c) else {
-        return (lo, hi);
-    };
-    let Some([a, b]) = &p.axes else {
-        return match c {
-            // Face-to-face diameter on a lattice (create::regular_shape).
-            Creation::LatticePile(_) | Creation::Row(_) => {
-                let cos = (std::f64::consts::PI / p.corners as f64).cos();
-                (lo, hi / cos)
-            }
-            _ => (lo, hi),
-        };
+/// The largest circumscribed diameter of particles drawn from `diameter` or
+/// `polygon.axes`: for polygons on ellipses of independent axes the largest over the
+/// corners of the axes' ranges and the start angle, sampled finely, plus 2 % (the
+/// centroid of an irregular polygon is off the ellipse's centre).
+pub fn reach_bound_of(diameter: Option<&Size>, polygon: Option<&PolygonSpec>) -> f64 {
+    let Some((p, [a, b])) = polygon.and_then(|p| p.axes.as_ref().map(|x| (p, x))) else {
+        return drawn_size_bounds(diameter, polygon).1;
     };
     let (a, b) = (a.bounds(), b.bounds());
     let mut reach: f64 = 0.0;
@@ -130,7 +105,42 @@ fn reach_bounds(c: &Creation) -> (f64, f64) {
             reach = reach.max(2.0 * crate::shape::circumradius(&v));
         }
     }
-    (lo, 1.02 * reach)
+    1.02 * reach
+}
+
+/// Smallest and largest full axes (or diameters) of a block's particles.
+fn size_bounds(c: &Creation) -> (f64, f64) {
+    match c {
+        Creation::LatticePile(p) => (
+            p.diameter * (1.0 - 0.5 * p.size_disorder),
+            p.diameter * (1.0 + 0.5 * p.size_disorder),
+        ),
+        Creation::Row(r) => (r.diameter, r.diameter),
+        Creation::PointSource(s) => drawn_size_bounds(s.diameter.as_ref(), s.polygon.as_ref()),
+        Creation::Layered(s) => drawn_size_bounds(s.diameter.as_ref(), s.polygon.as_ref()),
+        Creation::List(l) => l.particles.iter().fold((f64::MAX, 0.0), |(lo, hi), p| {
+            (lo.min(p.diameter), hi.max(p.diameter))
+        }),
+    }
+}
+
+/// Diameter of the circumscribed circle, bounded over the block's sizes: a disk's
+/// diameter; a regular polygon's circle (on a lattice, the face-to-face diameter over
+/// cos(π/C)); drawn polygons as [`reach_bound_of`].
+fn reach_bounds(c: &Creation) -> (f64, f64) {
+    let (lo, hi) = size_bounds(c);
+    match (c, polygon_of(c)) {
+        (Creation::PointSource(s), Some(_)) => {
+            (lo, reach_bound_of(s.diameter.as_ref(), s.polygon.as_ref()))
+        }
+        (Creation::Layered(s), Some(_)) => {
+            (lo, reach_bound_of(s.diameter.as_ref(), s.polygon.as_ref()))
+        }
+        (Creation::LatticePile(_) | Creation::Row(_), Some(p)) => {
+            (lo, hi / (std::f64::consts::PI / p.corners as f64).cos())
+        }
+        _ => (lo, hi),
+    }
 }
 
 /// Area of the smallest particle of a block: a disk, or a polygon on an ellipse with
@@ -151,6 +161,7 @@ fn material_of(c: &Creation) -> &str {
         Creation::LatticePile(p) => &p.material,
         Creation::Row(r) => &r.material,
         Creation::PointSource(s) => &s.material,
+        Creation::Layered(s) => &s.material,
         Creation::List(l) => &l.material,
     }
 }
@@ -190,6 +201,41 @@ pub fn shortest_contact_time(scene: &Scene, law: &ContactLaw) -> Option<f64> {
     best
 }
 
+/// Sizes drawn by sources and layers: `diameter` or `polygon.axes`, positive ranges.
+fn drawn_sizes(
+    at: &dyn Fn(&str) -> String,
+    diameter: Option<&Size>,
+    polygon: Option<&PolygonSpec>,
+) -> Result<(), SceneError> {
+    let axes = polygon.and_then(|p| p.axes.as_ref());
+    let sizes: Vec<(String, &Size)> = match (axes, diameter) {
+        (Some(_), Some(_)) => {
+            return Err(SceneError::invalid(
+                at("diameter"),
+                "give either diameter or polygon.axes, not both",
+            ));
+        }
+        (None, None) => {
+            return Err(SceneError::invalid(
+                at("diameter"),
+                "is required (or polygon.axes for polygons on ellipses)",
+            ));
+        }
+        (Some([a, b]), None) => vec![(at("polygon.axes[0]"), a), (at("polygon.axes[1]"), b)],
+        (None, Some(d)) => vec![(at("diameter"), d)],
+    };
+    for (path, size) in sizes {
+        let (lo, hi) = size.bounds();
+        if !(lo > 0.0 && lo <= hi && hi.is_finite()) {
+            return Err(SceneError::invalid(
+                path,
+                format!("must be positive (and lo ≤ hi for a range), got {lo}..{hi}"),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Polygon blocks: corner counts, axes only where sizes are drawn, and the contact law
 /// that goes with the shapes (disk–polygon contacts are not implemented yet).
 fn polygons(scene: &Scene) -> Result<(), SceneError> {
@@ -205,10 +251,11 @@ fn polygons(scene: &Scene) -> Result<(), SceneError> {
                         format!("must be in [{lo}, {hi}], got {}", p.corners),
                     ));
                 }
-                if p.axes.is_some() && !matches!(c, Creation::PointSource(_)) {
+                if p.axes.is_some() && !matches!(c, Creation::PointSource(_) | Creation::Layered(_))
+                {
                     return Err(SceneError::invalid(
                         at("polygon.axes"),
-                        "is only for point sources; other blocks make regular polygons of their diameter",
+                        "is only for point sources and layers; other blocks make regular polygons of their diameter",
                     ));
                 }
                 if !area_law {
@@ -334,33 +381,27 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 finite_non_negative(&at("spread"), s.spread)?;
                 finite_positive(&at("rate"), s.rate)?;
                 finite_non_negative(&at("start_time"), s.start_time)?;
-                let axes = s.polygon.as_ref().and_then(|p| p.axes.as_ref());
-                let sizes: Vec<(String, &crate::scene::Size)> = match (axes, &s.diameter) {
-                    (Some(_), Some(_)) => {
-                        return Err(SceneError::invalid(
-                            at("diameter"),
-                            "give either diameter or polygon.axes, not both",
-                        ));
-                    }
-                    (None, None) => {
-                        return Err(SceneError::invalid(
-                            at("diameter"),
-                            "is required (or polygon.axes for polygons on ellipses)",
-                        ));
-                    }
-                    (Some([a, b]), None) => {
-                        vec![(at("polygon.axes[0]"), a), (at("polygon.axes[1]"), b)]
-                    }
-                    (None, Some(d)) => vec![(at("diameter"), d)],
-                };
-                for (path, size) in sizes {
-                    let (lo, hi) = size.bounds();
-                    if !(lo > 0.0 && lo <= hi && hi.is_finite()) {
-                        return Err(SceneError::invalid(
-                            path,
-                            format!("must be positive (and lo ≤ hi for a range), got {lo}..{hi}"),
-                        ));
-                    }
+                drawn_sizes(&at, s.diameter.as_ref(), s.polygon.as_ref())?;
+            }
+            Creation::Layered(s) => {
+                inside(scene, &at("center_x"), [s.center_x, s.base_z])?;
+                finite_positive(&at("base_width"), s.base_width)?;
+                finite_positive(&at("interval"), s.interval)?;
+                finite_non_negative(&at("gap"), s.gap)?;
+                finite_non_negative(&at("start_time"), s.start_time)?;
+                if !(s.slope > 0.0 && s.slope < 90.0) {
+                    return Err(SceneError::invalid(
+                        at("slope"),
+                        format!("must be between 0 and 90 degrees, got {}", s.slope),
+                    ));
+                }
+                drawn_sizes(&at, s.diameter.as_ref(), s.polygon.as_ref())?;
+                let d = reach_bound_of(s.diameter.as_ref(), s.polygon.as_ref());
+                if s.base_width < d {
+                    return Err(SceneError::invalid(
+                        at("base_width"),
+                        format!("{} holds no particle of size up to {d}", s.base_width),
+                    ));
                 }
             }
             Creation::List(l) => {

@@ -1,0 +1,70 @@
+//! Layer-by-layer construction (paper 000 sec. 5.4.2): rows narrowing with the outline,
+//! dropped gently onto the pile.
+
+mod common;
+use common::*;
+use serde_json::json;
+
+fn layered_pile(polygons: bool) -> serde_json::Value {
+    let mut block = json!({ "kind": "layered", "material": "m", "diameter": 1.0,
+                            "base_width": 16.0, "slope": 30.0, "interval": 1.5, "gap": 0.3 });
+    let law = if polygons {
+        block["polygon"] = json!({ "corners": 7 });
+        json!({ "law": "overlap_area", "k_n": 2000.0, "eta_n": 0.5, "mu": 0.5 })
+    } else {
+        json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 10.0, "k_t": 571.4, "gamma_t": 2.0, "mu": 0.5 })
+    };
+    let mut v = scene_value(law, json!([block]));
+    v["dt"] = json!(0.002);
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-30.0, 0.0], "to": [30.0, 0.0] }]);
+    v
+}
+
+#[test]
+fn rows_narrow_with_the_outline_and_land_gently() {
+    for polygons in [false, true] {
+        let mut s = sim(&layered_pile(polygons));
+        // Row k is 16 − 3k wide (h = (√3/2) d, tan 30°): 16, 13, 10, 7, 4, 1 particles.
+        let mut worst: f64 = 0.0;
+        let mut counts = Vec::new();
+        for _ in 0..(12.0 / 0.002) as usize {
+            let before = s.particles.len();
+            s.step().unwrap();
+            if s.particles.len() > before {
+                counts.push(s.particles.len() - before);
+            }
+            for c in &s.contacts {
+                worst = worst.max(c.overlap);
+            }
+        }
+        assert_eq!(
+            counts,
+            vec![16, 13, 10, 7, 4, 1],
+            "polygons {polygons}: rows"
+        );
+        assert!(s.feeding_done(), "all rows laid");
+        assert_eq!(s.lost, 0);
+        // Dropped from 0.3 d: no violent impacts, overlaps stay small.
+        assert!(worst < 0.02, "polygons {polygons}: largest overlap {worst}");
+        // The top particle sits on the centre line, about five rows up.
+        let top = (0..s.particles.len())
+            .max_by(|&a, &b| s.particles.q[0][a][1].total_cmp(&s.particles.q[0][b][1]))
+            .unwrap();
+        let [x, z] = s.particles.position(top);
+        assert!(x.abs() < 1.5, "polygons {polygons}: top at x = {x}");
+        assert!(z > 3.5 && z < 6.0, "polygons {polygons}: top at z = {z}");
+    }
+}
+
+#[test]
+fn layered_scenes_are_refused_by_the_gpu_path_with_a_reason() {
+    let s = sim(&layered_pile(false));
+    let Some(gpu) = common::gpu("layered_scenes_are_refused") else {
+        return;
+    };
+    let err = talus::gpu::GpuSimulation::with_gpu(s, gpu)
+        .err()
+        .expect("refused");
+    assert!(err.to_string().contains("layer-by-layer"), "{err}");
+}
