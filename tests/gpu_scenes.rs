@@ -326,17 +326,17 @@ fn overlaps_are_the_same_at_x_0_and_at_x_10000_diameters() {
     }
 }
 
-#[test]
-fn gpu_runs_are_bitwise_reproducible_and_resume_bitwise() {
-    let Some(mut a) = gpu_sim("gpu_runs_are_bitwise_reproducible", quick_pour()) else {
+/// Two GPU runs of a scene are bitwise equal, and so is one resumed through a checkpoint
+/// file in a fresh device context.
+fn assert_gpu_bitwise(name: &str, scene: fn() -> talus::scene::Scene, steps: u64) {
+    let Some(mut a) = gpu_sim(name, scene()) else {
         return;
     };
-    let mut b = gpu_sim("gpu_runs_are_bitwise_reproducible", quick_pour()).unwrap();
-    let steps = 6000;
+    let mut b = gpu_sim(name, scene()).unwrap();
     a.advance(steps).unwrap();
     b.advance(steps / 2).unwrap();
     // b: through a checkpoint file, then on in a fresh device context.
-    let dir = std::env::temp_dir().join(format!("talus-gpu-resume-{}", std::process::id()));
+    let dir = std::env::temp_dir().join(format!("talus-gpu-resume-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("ckpt.bin");
     talus::checkpoint::write(b.download(), &path).unwrap();
@@ -359,9 +359,20 @@ fn gpu_runs_are_bitwise_reproducible_and_resume_bitwise() {
         "resumed GPU run differs from the uninterrupted one"
     );
     // And a third, uninterrupted run is the same bit for bit.
-    let mut c = gpu_sim("gpu_runs_are_bitwise_reproducible", quick_pour()).unwrap();
+    let mut c = gpu_sim(name, scene()).unwrap();
     c.advance(steps).unwrap();
     assert!(c.device_state() == sa, "two GPU runs of one scene differ");
+}
+
+#[test]
+fn gpu_runs_are_bitwise_reproducible_and_resume_bitwise() {
+    assert_gpu_bitwise("gpu_runs_are_bitwise_reproducible", quick_pour, 6000);
+}
+
+#[test]
+fn gpu_polygon_runs_are_bitwise_reproducible_and_resume_bitwise() {
+    // Polygons: the corner buffer is laid out afresh on resume.
+    assert_gpu_bitwise("gpu_polygon_runs_are_bitwise", polygon_pour, 4500);
 }
 
 #[test]
