@@ -8,7 +8,7 @@
 
 use crate::cell_list::{CellList, Grid};
 use crate::geometry::{WallSegment, disk_disk, disk_wall};
-use crate::overlap::{overlap_area, polygon_wall};
+use crate::overlap::{overlap_area, polygon_disk, polygon_wall};
 use crate::shape::WorldShapes;
 use crate::state::Particles;
 
@@ -44,10 +44,12 @@ pub fn interacts(
     if g.r.is_nan() || g.r >= range_factor * g.sigma {
         return false;
     }
-    if particles.is_polygon(i) {
-        return overlap_area(shapes.of(i), pi, shapes.of(j)) > 0.0;
+    match (particles.is_polygon(i), particles.is_polygon(j)) {
+        (true, true) => overlap_area(shapes.of(i), pi, shapes.of(j)) > 0.0,
+        (true, false) => polygon_disk(shapes.of(i), pi, pj, particles.radius[j], true).is_some(),
+        (false, true) => polygon_disk(shapes.of(j), pj, pi, particles.radius[i], false).is_some(),
+        (false, false) => true,
     }
-    true
 }
 
 /// Whether particle i touches wall w.

@@ -10,7 +10,7 @@
 use crate::contacts::{Pair, WALL_BASE};
 use crate::geometry::{Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent};
 use crate::law::{ContactInput, ContactLaw};
-use crate::overlap::{polygon_polygon, polygon_wall};
+use crate::overlap::{disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall};
 use crate::shape::WorldShapes;
 use crate::state::{Dof, Particles};
 
@@ -46,7 +46,8 @@ pub fn contact_forces(
     out.clear();
     history_out.clear();
     for (&pair, &history) in pairs.iter().zip(history_in) {
-        let (g, input) = contact_input(particles, shapes, walls, dt, pair, history);
+        let area = matches!(law, ContactLaw::OverlapArea(_));
+        let (g, input) = contact_input(particles, shapes, walls, dt, area, pair, history);
         let res = law.evaluate(&input);
         let t = tangent(g.n);
         let force = [
@@ -67,16 +68,18 @@ pub fn contact_forces(
 }
 
 /// Geometry and kinematics of one contact: what the law needs.
+/// `area`: the overlap-area law, which sees every pair (disks too) by its overlap area.
 pub fn contact_input(
     particles: &Particles,
     shapes: &WorldShapes,
     walls: &[WallSegment],
     dt: f64,
+    area: bool,
     pair: Pair,
     history: f64,
 ) -> (Geometry, ContactInput) {
     let i = pair.i as usize;
-    if particles.is_polygon(i) {
+    if area {
         return area_contact_input(particles, shapes, walls, dt, pair, history);
     }
     let p1 = particles.position(i);
@@ -162,11 +165,23 @@ fn area_contact_input(
 ) -> (Geometry, ContactInput) {
     let i = pair.i as usize;
     let p1 = particles.position(i);
+    let (ri, poly_i) = (particles.radius[i], particles.is_polygon(i));
     let c = if pair.is_wall() {
-        polygon_wall(shapes.of(i), p1, &walls[(pair.j - WALL_BASE) as usize])
+        let wall = &walls[(pair.j - WALL_BASE) as usize];
+        if poly_i {
+            polygon_wall(shapes.of(i), p1, wall)
+        } else {
+            disk_wall_area(p1, ri, wall)
+        }
     } else {
         let j = pair.j as usize;
-        polygon_polygon(shapes.of(i), p1, shapes.of(j), particles.position(j))
+        let p2 = particles.position(j);
+        match (poly_i, particles.is_polygon(j)) {
+            (true, true) => polygon_polygon(shapes.of(i), p1, shapes.of(j), p2),
+            (true, false) => polygon_disk(shapes.of(i), p1, p2, particles.radius[j], true),
+            (false, true) => polygon_disk(shapes.of(j), p2, p1, ri, false),
+            (false, false) => disk_disk_area(p1, ri, p2, particles.radius[j]),
+        }
     }
     .unwrap_or_default();
     let v1 = particles.velocity(i, dt);

@@ -447,3 +447,207 @@ mod tests {
         assert!((g.chord - 0.2).abs() < 1e-15 && (g.point[0] - 4.9).abs() < 1e-15);
     }
 }
+
+// ---- Disks under the overlap-area law (SPEC 2.3 for mixed scenes; CPU path) ----
+
+/// Signed area of the triangle (0, a, b) inside the circle of radius r about the origin:
+/// the segment ab is split where it crosses the circle; pieces inside add their triangle,
+/// pieces outside the circular sector they subtend.
+fn triangle_in_circle(a: P2, b: P2, r: f64) -> f64 {
+    let d = sub(b, a);
+    let (qa, qb, qc) = (dot(d, d), 2.0 * dot(a, d), dot(a, a) - r * r);
+    let mut ts = vec![0.0];
+    let disc = qb * qb - 4.0 * qa * qc;
+    if qa > 0.0 && disc > 0.0 {
+        let s = disc.sqrt();
+        for t in [(-qb - s) / (2.0 * qa), (-qb + s) / (2.0 * qa)] {
+            if t > 0.0 && t < 1.0 {
+                ts.push(t);
+            }
+        }
+    }
+    ts.push(1.0);
+    let at = |t: f64| [a[0] + t * d[0], a[1] + t * d[1]];
+    ts.windows(2)
+        .map(|w| {
+            let (p, q) = (at(w[0]), at(w[1]));
+            let m = at(0.5 * (w[0] + w[1]));
+            let c = p[0] * q[1] - p[1] * q[0];
+            if dot(m, m) <= r * r {
+                0.5 * c
+            } else {
+                0.5 * r * r * c.atan2(dot(p, q))
+            }
+        })
+        .sum()
+}
+
+/// Points where the circle (c, r) crosses the outline of polygon p (half-open edges).
+fn circle_crossings(p: &[P2], c: P2, r: f64, out: &mut Poly) {
+    out.n = 0;
+    let n = p.len();
+    for k in 0..n {
+        let (a, b) = (sub(p[k], c), sub(p[(k + 1) % n], c));
+        let d = sub(b, a);
+        let (qa, qb, qc) = (dot(d, d), 2.0 * dot(a, d), dot(a, a) - r * r);
+        let disc = qb * qb - 4.0 * qa * qc;
+        if qa == 0.0 || disc < 0.0 {
+            continue;
+        }
+        let s = disc.sqrt();
+        for t in [(-qb - s) / (2.0 * qa), (-qb + s) / (2.0 * qa)] {
+            if (0.0..1.0).contains(&t) && out.n < MAX_CLIP {
+                out.push([c[0] + a[0] + t * d[0], c[1] + a[1] + t * d[1]]);
+            }
+        }
+    }
+}
+
+/// Area contact of polygon p (centre cp) and the disk (c, r); `polygon_is_i` says which
+/// of the two is particle i (n points from j to i). The force point is the midpoint of
+/// the two crossings farthest apart; corners of the polygon inside the disk and the
+/// disk's centre lie on the disk's side of that line.
+pub fn polygon_disk(p: &[P2], cp: P2, c: P2, r: f64, polygon_is_i: bool) -> Option<AreaContact> {
+    let n = p.len();
+    let area: f64 = (0..n)
+        .map(|k| triangle_in_circle(sub(p[k], c), sub(p[(k + 1) % n], c), r))
+        .sum();
+    if area <= 0.0 {
+        return None;
+    }
+    let mut crossed = Poly::default();
+    circle_crossings(p, c, r, &mut crossed);
+    let xs = crossed.corners();
+    let scale = norm(sub(cp, c)) + r + norm(sub(p[0], cp));
+    let (ci, cj) = if polygon_is_i { (cp, c) } else { (c, cp) };
+    let centres = sub(ci, cj);
+    let along = if norm(centres) > 0.0 {
+        [centres[0] / norm(centres), centres[1] / norm(centres)]
+    } else {
+        [0.0, 1.0]
+    };
+    let (mut n_vec, point, chord) = if xs.len() >= 2 {
+        let (a, b) = farthest_pair(xs);
+        let chord = norm(sub(b, a));
+        if chord > 1e-12 * scale {
+            let t = [(b[0] - a[0]) / chord, (b[1] - a[1]) / chord];
+            (
+                [-t[1], t[0]],
+                [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])],
+                chord,
+            )
+        } else {
+            (along, c, 0.0)
+        }
+    } else {
+        (along, c, 0.0)
+    };
+    if chord > 0.0 {
+        // Score the disk's side: its centre and the polygon's corners inside it.
+        let disk_side: f64 = dot(n_vec, sub(c, point))
+            + p.iter()
+                .filter(|v| dot(sub(**v, c), sub(**v, c)) < r * r)
+                .map(|v| dot(n_vec, sub(*v, point)))
+                .sum::<f64>();
+        // n must point from j to i: away from the disk when the polygon is i.
+        let towards_disk = disk_side > 0.0;
+        if towards_disk == polygon_is_i {
+            n_vec = [-n_vec[0], -n_vec[1]];
+        }
+    }
+    let l = reduced_arm(norm(sub(point, ci)), norm(sub(point, cj)), scale);
+    Some(AreaContact {
+        area,
+        n: n_vec,
+        point,
+        chord,
+        l,
+    })
+}
+
+/// Area contact of two disks: the lens between them, the chord through the circles'
+/// crossings, n along the line of centres.
+pub fn disk_disk_area(ci: P2, ri: f64, cj: P2, rj: f64) -> Option<AreaContact> {
+    let dv = sub(ci, cj);
+    let d = norm(dv);
+    if d >= ri + rj {
+        return None;
+    }
+    let n = if d > 0.0 {
+        [dv[0] / d, dv[1] / d]
+    } else {
+        [0.0, 1.0]
+    };
+    if d <= (ri - rj).abs() {
+        // One inside the other: the smaller disk's area, at its centre.
+        let (small, cs) = if ri < rj { (ri, ci) } else { (rj, cj) };
+        let area = std::f64::consts::PI * small * small;
+        let l = reduced_arm(norm(sub(cs, ci)), norm(sub(cs, cj)), ri + rj);
+        return Some(AreaContact {
+            area,
+            n,
+            point: cs,
+            chord: 0.0,
+            l,
+        });
+    }
+    // Distances of the chord from each centre along the line of centres.
+    let a_j = (d * d + rj * rj - ri * ri) / (2.0 * d);
+    let a_i = d - a_j;
+    let h = (rj * rj - a_j * a_j).max(0.0).sqrt();
+    // Circular segment beyond a chord at distance a from the centre of a circle r.
+    let segment = |r: f64, a: f64| {
+        let theta = h.atan2(a);
+        r * r * (theta - theta.sin() * theta.cos())
+    };
+    let area = segment(ri, a_i) + segment(rj, a_j);
+    let point = [cj[0] + n[0] * a_j, cj[1] + n[1] * a_j];
+    let l = reduced_arm(a_i.abs(), a_j.abs(), ri + rj);
+    Some(AreaContact {
+        area,
+        n,
+        point,
+        chord: 2.0 * h,
+        l,
+    })
+}
+
+/// Area contact of a disk and a wall segment: the circular segment beyond the wall's
+/// line; where the chord reaches past an end of the wall only the part over the wall
+/// counts (its area scaled by that fraction of the chord, an approximation at the ends).
+pub fn disk_wall_area(c: P2, r: f64, w: &WallSegment) -> Option<AreaContact> {
+    let ab = sub(w.b, w.a);
+    let len = norm(ab);
+    if len == 0.0 {
+        return None;
+    }
+    let t = [ab[0] / len, ab[1] / len];
+    let mut m = [-t[1], t[0]];
+    let mut dist = dot(m, sub(c, w.a));
+    if dist < 0.0 {
+        m = [-m[0], -m[1]];
+        dist = -dist;
+    }
+    if dist >= r {
+        return None;
+    }
+    let h = (r * r - dist * dist).sqrt();
+    let s = dot(sub(c, w.a), t);
+    let (lo, hi) = ((s - h).max(0.0), (s + h).min(len));
+    if hi <= lo {
+        return None;
+    }
+    let theta = h.atan2(dist);
+    let full = r * r * (theta - theta.sin() * theta.cos());
+    let area = full * (hi - lo) / (2.0 * h);
+    let mid = 0.5 * (lo + hi);
+    let point = [w.a[0] + mid * t[0], w.a[1] + mid * t[1]];
+    let l = norm(sub(point, c)).max(1e-9 * r);
+    Some(AreaContact {
+        area,
+        n: m,
+        point,
+        chord: hi - lo,
+        l,
+    })
+}

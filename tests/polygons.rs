@@ -390,3 +390,167 @@ fn collision_energy_is_bounded_without_damping_and_decays_with_it() {
     let last = *damped.last().unwrap();
     assert!(last < 0.9 * e0, "damping dissipates: {last} vs {e0}");
 }
+
+/// The area of polygon ∩ disk by integrating, over x, the overlap of the two vertical
+/// intervals (both are convex), with composite Simpson on fine strips: independent of
+/// the edge-by-edge circle formula.
+fn integrated_area(p: &[P2], c: P2, r: f64) -> f64 {
+    let lo = p
+        .iter()
+        .map(|v| v[0])
+        .fold(f64::INFINITY, f64::min)
+        .max(c[0] - r);
+    let hi = p
+        .iter()
+        .map(|v| v[0])
+        .fold(f64::NEG_INFINITY, f64::max)
+        .min(c[0] + r);
+    if hi <= lo {
+        return 0.0;
+    }
+    let column = |x: f64| -> f64 {
+        let (mut a, mut b) = (f64::INFINITY, f64::NEG_INFINITY);
+        let n = p.len();
+        for k in 0..n {
+            let (u, v) = (p[k], p[(k + 1) % n]);
+            if (u[0] - x) * (v[0] - x) <= 0.0 && u[0] != v[0] {
+                let z = u[1] + (x - u[0]) / (v[0] - u[0]) * (v[1] - u[1]);
+                a = a.min(z);
+                b = b.max(z);
+            }
+        }
+        let h = (r * r - (x - c[0]) * (x - c[0])).max(0.0).sqrt();
+        (b.min(c[1] + h) - a.max(c[1] - h)).max(0.0)
+    };
+    let n = 200_000;
+    let h = (hi - lo) / n as f64;
+    let mut s = column(lo) + column(hi);
+    for k in 1..n {
+        s += column(lo + k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 };
+    }
+    s * h / 3.0
+}
+
+#[test]
+fn polygon_disk_and_disk_disk_overlaps() {
+    use talus::overlap::{disk_disk_area, polygon_disk};
+    let mut rng = Rng::new(11);
+    let mut checked = 0;
+    for _ in 0..300 {
+        let (p, cp) = random_polygon(&mut rng, [0.0, 0.0]);
+        let c = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
+        let r = rng.range(0.3, 0.8);
+        let expect = integrated_area(&p, c, r);
+        let Some(g) = polygon_disk(&p, cp, c, r, true) else {
+            assert!(expect < 1e-9, "missed an overlap of area {expect}");
+            continue;
+        };
+        checked += 1;
+        assert!(
+            (g.area - expect).abs() < 1e-7,
+            "area {} vs {expect}",
+            g.area
+        );
+        let h = polygon_disk(&p, cp, c, r, false).unwrap();
+        assert_eq!(h.area, g.area);
+        assert!((h.l - g.l).abs() < 1e-12);
+        if g.chord > 1e-6 && g.area < 0.1 * area(&p).min(std::f64::consts::PI * r * r) {
+            assert_eq!(
+                (h.n[0], h.n[1]),
+                (-g.n[0], -g.n[1]),
+                "swapped: opposite normal"
+            );
+            // Crossings on both outlines, and n pointing from the disk to the polygon.
+            let t = [-g.n[1], g.n[0]];
+            for s in [-0.5, 0.5] {
+                let x = [
+                    g.point[0] + s * g.chord * t[0],
+                    g.point[1] + s * g.chord * t[1],
+                ];
+                assert!(distance_to_outline(x, &p) < 1e-9);
+                assert!(((x[0] - c[0]).hypot(x[1] - c[1]) - r).abs() < 1e-9);
+            }
+            let eps = 1e-4 * g.chord;
+            let moved: Vec<P2> = p
+                .iter()
+                .map(|v| [v[0] + eps * g.n[0], v[1] + eps * g.n[1]])
+                .collect();
+            assert!(
+                integrated_area(&moved, c, r) < g.area,
+                "moving i along n shrinks the overlap"
+            );
+        }
+    }
+    assert!(checked > 100, "{checked} overlapping pairs");
+    // Two disks: the lens against the integral over a 16-gon-free circle pair, by the
+    // same strip integration of the two circles' vertical chords.
+    for (d, r1, r2) in [(1.9, 1.0, 1.0), (1.2, 1.0, 0.5), (0.9999, 0.5, 0.5)] {
+        let g = disk_disk_area([d, 0.0], r1, [0.0, 0.0], r2).unwrap();
+        let n = 400_000;
+        let (lo, hi) = ((d - r1).max(-r2), r2.min(d + r1));
+        let h = (hi - lo) / n as f64;
+        let col = |x: f64| {
+            let a = (r1 * r1 - (x - d) * (x - d)).max(0.0).sqrt();
+            let b = (r2 * r2 - x * x).max(0.0).sqrt();
+            2.0 * a.min(b)
+        };
+        let mut s = col(lo) + col(hi);
+        for k in 1..n {
+            s += col(lo + k as f64 * h) * if k % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        let expect = s * h / 3.0;
+        assert!(
+            (g.area - expect).abs() < 1e-6 * expect.max(1e-6),
+            "lens {} vs {expect}",
+            g.area
+        );
+        assert_eq!(g.n, [1.0, 0.0]);
+    }
+}
+
+#[test]
+fn a_disk_rests_on_a_square_and_the_floor_carries_both() {
+    // A square on the floor and a disk on its top face, both under the area law
+    // (polygon–disk and polygon–wall contacts): at rest the floor carries the weight of
+    // both and the square the weight of the disk.
+    let mut v = scene_value(
+        area_law(1e4, 0.5, 0.5),
+        json!([
+            { "kind": "list", "material": "m", "polygon": { "corners": 4 },
+              "particles": [{ "position": [0.0, 0.5], "diameter": 2f64.sqrt(),
+                              "theta": std::f64::consts::FRAC_PI_4 }] },
+            { "kind": "list", "material": "m", "particles": [{ "position": [0.0, 1.4], "diameter": 0.8 }] }
+        ]),
+    );
+    v["dt"] = json!(2e-4);
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-3.0, 0.0], "to": [3.0, 0.0] }]);
+    let mut s = sim(&v);
+    for _ in 0..40_000 {
+        s.step().unwrap();
+    }
+    let weight = s.particles.mass[0] + s.particles.mass[1];
+    let floor: f64 = s
+        .pairs
+        .iter()
+        .zip(&s.contacts)
+        .filter(|(p, _)| p.is_wall())
+        .map(|(_, c)| c.force[1])
+        .sum();
+    let on_square: f64 = s
+        .pairs
+        .iter()
+        .zip(&s.contacts)
+        .filter(|(p, _)| p.i == 0 && p.j == 1)
+        .map(|(_, c)| -c.force[1])
+        .sum();
+    assert!(
+        (floor - weight).abs() < 1e-6 * weight,
+        "floor carries {floor} of {weight}"
+    );
+    let disk = s.particles.mass[1];
+    assert!(
+        (on_square - disk).abs() < 1e-6 * disk,
+        "square carries {on_square} of {disk}"
+    );
+}

@@ -237,7 +237,7 @@ fn drawn_sizes(
 }
 
 /// Polygon blocks: corner counts, axes only where sizes are drawn, and the contact law
-/// that goes with the shapes (disk–polygon contacts are not implemented yet).
+/// that goes with the shapes.
 fn polygons(scene: &Scene) -> Result<(), SceneError> {
     let area_law = matches!(scene.contact, ContactSpec::OverlapArea(_));
     for (k, c) in scene.particles.iter().enumerate() {
@@ -267,12 +267,8 @@ fn polygons(scene: &Scene) -> Result<(), SceneError> {
                     ));
                 }
             }
-            None if area_law => {
-                return Err(SceneError::invalid(
-                    at("polygon"),
-                    "is required: the overlap_area law is for polygons (disk–polygon contacts are not implemented yet)",
-                ));
-            }
+            // Disks under the overlap-area law meet polygons, walls and each other by
+            // their overlap area too (CPU path).
             None => {}
         }
     }
