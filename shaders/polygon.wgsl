@@ -31,12 +31,31 @@ fn no_contact() -> AreaContact {
     return AreaContact(0.0, vec2<f32>(0.0, 1.0), vec2<f32>(0.0), 0.0, 0.0, false);
 }
 
+// (sin x, cos x) to about one ulp. Vulkan only requires sin and cos to be within 2^-11
+// absolutely, and GPUs use fast hardware approximations (~4e-7): on a corner half a
+// diameter out that would be 2e-7 d, more than the whole f32 budget of the overlap.
+// Range reduction by quarter turns (pi/2 in two parts, the first product exact for the
+// small multiples that occur: polygon angles are kept in [-pi, pi]), then Taylor series
+// on [-pi/4, pi/4] (next terms below 2e-9).
+fn sin_cos(x: f32) -> vec2<f32> {
+    let q = round(x * 0.63661977236758134);
+    let r = (x - q * 1.5707963705062866) + q * 4.37113900018624283e-8;
+    let r2 = r * r;
+    let s = r * (1.0 + r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 * (1.0 / 362880.0)))));
+    let c = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24.0 + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40320.0 + r2 * (-1.0 / 3628800.0)))));
+    let k = (i32(q) % 4 + 4) % 4;
+    if (k == 0) { return vec2<f32>(s, c); }
+    if (k == 1) { return vec2<f32>(c, -s); }
+    if (k == 2) { return vec2<f32>(-s, -c); }
+    return vec2<f32>(-c, s);
+}
+
 // Corners of particle k in the world orientation, shifted by `centre`.
 fn load_polygon(k: u32, centre: vec2<f32>, out: ptr<function, array<vec2<f32>, 16>>) -> u32 {
     let sh = props[k].shape;
-    let th = state[k].q[0].z;
-    let c = cos(th);
-    let s = sin(th);
+    let sc = sin_cos(state[k].q[0].z);
+    let c = sc.y;
+    let s = sc.x;
     for (var m = 0u; m < sh.y; m++) {
         let v = corners[sh.x + m];
         (*out)[m] = centre + vec2<f32>(c * v.x - s * v.y, s * v.x + c * v.y);
