@@ -88,8 +88,9 @@ fn reduced_arm(li: f32, lj: f32, scale: f32) -> f32 {
     return a * b / (a + b);
 }
 
-// Area contact of polygon p (np corners, centre 0) with polygon q (nq corners, centre cj).
-fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32,
+// Area contact of polygon p (np corners, centre ci) with polygon q (nq corners, centre
+// cj); the force point comes back in the same frame.
+fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32, ci: vec2<f32>,
                    q: ptr<function, array<vec2<f32>, 16>>, nq: u32, cj: vec2<f32>,
                    only_area: bool) -> AreaContact {
     var v: array<array<vec2<f32>, MAX_CLIP>, 2>;
@@ -99,7 +100,7 @@ fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32,
     for (var k = 0u; k < np; k++) {
         v[0][k] = (*p)[k];
         origin[0][k] = ORIGIN_P | 4u;
-        r2 = max(r2, dot((*p)[k], (*p)[k]));
+        r2 = max(r2, dot((*p)[k] - ci, (*p)[k] - ci));
     }
     let r = sqrt(r2);
     var cur = 0u;
@@ -108,7 +109,7 @@ fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32,
         let b = (*q)[(k + 1u) % nq];
         let m = vec2<f32>(-(b.y - a.y), b.x - a.x);
         let reach = r * length(m);
-        let centre = dot(-a, m);
+        let centre = dot(ci - a, m);
         if (centre >= reach) { continue; }
         if (centre <= -reach) { count[cur] = 0u; break; }
         let dst = 1u - cur;
@@ -161,9 +162,9 @@ fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32,
             if (d > best) { best = d; xa = v[cur][a]; xb = v[cur][b]; }
         }
     }
-    let scale = length(cj) + r;
+    let scale = length(cj - ci) + r;
     var along = vec2<f32>(0.0, 1.0);
-    if (length(cj) > 0.0) { along = -cj / length(cj); }
+    if (length(cj - ci) > 0.0) { along = (ci - cj) / length(cj - ci); }
     let chord = length(xb - xa);
     if (best >= 0.0 && chord > 1.0e-6 * scale) {
         let t = (xb - xa) / chord;
@@ -176,7 +177,7 @@ fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32,
             if (o == ORIGIN_P) { side += dot(nn, v[cur][k] - s); }
             if (o == ORIGIN_Q) { side -= dot(nn, v[cur][k] - s); }
         }
-        if (side > 0.0 || (side == 0.0 && dot(nn, -cj) < 0.0)) { nn = -nn; }
+        if (side > 0.0 || (side == 0.0 && dot(nn, ci - cj) < 0.0)) { nn = -nn; }
         g.n = nn;
         g.point = s;
         g.chord = chord;
@@ -185,7 +186,7 @@ fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32,
         g.point = corner_mean(&v, cur, n);
         g.chord = 0.0;
     }
-    g.l = reduced_arm(length(g.point), length(g.point - cj), scale);
+    g.l = reduced_arm(length(g.point - ci), length(g.point - cj), scale);
     return g;
 }
 
@@ -254,14 +255,18 @@ fn polygon_wall(p: ptr<function, array<vec2<f32>, 16>>, np: u32, wa: vec2<f32>, 
     return g;
 }
 
-// The area contact of particle i with particle j (both polygons), in i's frame.
+// The area contact of particle i with particle j (both polygons). It is computed in a
+// frame centred between them, where the corners that meet are smallest, and the force
+// point is returned relative to centre i.
 fn polygons_ij(i: u32, j: u32, only_area: bool) -> AreaContact {
     var p: array<vec2<f32>, 16>;
     var q: array<vec2<f32>, 16>;
-    let cj = -offset_vector(offset_ij(i, j));
-    let np = load_polygon(i, vec2<f32>(0.0), &p);
-    let nq = load_polygon(j, cj, &q);
-    return polygon_polygon(&p, np, &q, nq, cj, only_area);
+    let half = -0.5 * offset_vector(offset_ij(i, j));
+    let np = load_polygon(i, -half, &p);
+    let nq = load_polygon(j, half, &q);
+    var g = polygon_polygon(&p, np, -half, &q, nq, half, only_area);
+    g.point += half;
+    return g;
 }
 
 // The area contact of particle i with wall w, in i's frame.
