@@ -3,10 +3,10 @@
 // corners are crossings of the two outlines; the line through the two crossings farthest
 // apart gives the normal, its midpoint the force point.
 //
-// Everything is computed in the frame of particle i's centre: i's corners are R(theta)v,
-// j's are (c_j - c_i) + R(theta_j)w with the exact fixed-point offset rounded once to
-// f32. Corner coordinates then carry ~3e-8 d of rounding, so an area overlap A/l is
-// resolved to about 1e-7 d (README, "Precision").
+// A pair is computed in a frame centred between the two particles: corners are
+// -+ (c_j - c_i)/2 + R(theta)v, with the exact fixed-point offset rounded once to f32;
+// a wall contact in particle i's frame. Corner coordinates then carry ~3e-8 d of
+// rounding, so an area overlap A/l is resolved to about 1e-7 d (README, "Precision").
 
 const MAX_CLIP: u32 = 36u;
 
