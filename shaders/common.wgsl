@@ -83,12 +83,15 @@ struct Params {
     _pad: u32,
 };
 
-// Dynamic state: q[0] = (rem_x, rem_z, theta, 0) with the position's remainder in
-// units (position.wgsl), q[k] = (dt^k/k!) d^k/dt^k in length units.
+// Dynamic state: q[0] = (rem_x, rem_z, rem_theta, 0) with the position's remainder in
+// units (position.wgsl) and the orientation's in turn units (orientation.wgsl),
+// q[k] = (dt^k/k!) d^k/dt^k in length units and radians.
 struct State {
     q: array<vec4<f32>, 6>,
     anchor: vec2<i32>,
     frac: vec2<u32>,
+    turn: u32,
+    _pad: array<u32, 3>,
 };
 
 struct Props {
@@ -146,9 +149,10 @@ struct Candidate {
     flags: u32,
     radius_units: u32,
     radius_rem: f32,
-    theta: f32,
+    turn: u32,           // orientation: whole turn units and remainder
     shape: vec2<u32>,
-    _pad: vec2<u32>,
+    turn_rem: f32,
+    _pad: u32,
 };
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -171,8 +175,9 @@ struct Candidate {
 @group(0) @binding(17) var<storage, read_write> control: array<atomic<u32>>;
 @group(0) @binding(18) var<storage, read_write> sources: array<Source>;
 @group(0) @binding(19) var<storage, read_write> candidates: array<Candidate>;
-// Polygon corners in the body frame (counter-clockwise, centroid at the origin).
-@group(0) @binding(20) var<storage, read_write> corners: array<vec2<f32>>;
+// Polygon corners in whole position units (counter-clockwise, centroid at the origin):
+// xy in the body frame, zw rotated to the particle's orientation (orientation.wgsl).
+@group(0) @binding(20) var<storage, read_write> corners: array<vec4<i32>>;
 // The spring table of the previous step (read) and of this step (written); the host
 // swaps the two buffers every step.
 @group(1) @binding(0) var<storage, read_write> table_old: array<Entry>;

@@ -10,7 +10,7 @@ fn acceleration(i: u32, g: vec2<f32>) -> vec4<f32> {
 fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
     let half_dt2 = 0.5 * params.dt * params.dt;
     let delta = half_dt2 * accel - (*s).q[2];
-    (*s).q[0].z += (3.0 / 20.0) * delta.z;
+    turn_by(s, (3.0 / 20.0) * delta.z);
     displace(s, (3.0 / 20.0) * delta.xy);
     (*s).q[1] += (251.0 / 360.0) * delta;
     (*s).q[2] += delta;
@@ -28,6 +28,6 @@ fn correct(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = state[i];
     correct_one(&s, acceleration(i, g));
     renormalize(&s);
-    if (props[i].shape.y > 0u) { wrap_angle(&s); }
+    renormalize_turn(&s);
     state[i] = s;
 }

@@ -51,7 +51,8 @@ fn insert_place() {
             }
             if (blocked) { continue; }
             var st: State;
-            st.q[0] = vec4<f32>(cand.rem, cand.theta, 0.0);
+            st.q[0] = vec4<f32>(cand.rem, cand.turn_rem, 0.0);
+            st.turn = cand.turn;
             st.q[1] = vec4<f32>(cand.velocity, 0.0, 0.0);
             if (params.integrator == 0u) {
                 // Gear starts with the gravitational acceleration in q2.
@@ -63,6 +64,7 @@ fn insert_place() {
             state[n] = st;
             props[n] = Props(cand.radius, cand.mass, cand.inv_inertia, cand.flags,
                              cand.radius_units, cand.radius_rem, cand.shape);
+            rotate_corners(n, st);
             atomicStore(&control[C_LIVE], n + 1u);
             sources[s].inserted = k + 1u;
         }

@@ -14,9 +14,10 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = state[i];
     let a = acceleration(i, g);
     s.q[1] += a * params.dt * params.dt;
-    s.q[0].z += s.q[1].z;
+    turn_by(&s, s.q[1].z);
     displace(&s, s.q[1].xy);
     renormalize(&s);
-    if (props[i].shape.y > 0u) { wrap_angle(&s); }
+    renormalize_turn(&s);
     state[i] = s;
+    rotate_corners(i, s);
 }

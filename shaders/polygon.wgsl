@@ -1,12 +1,23 @@
 // Overlap-area geometry of convex polygons (src/overlap.rs, SPEC 2.3), step for step:
-// p clipped by the edges of q near the contact (Sutherland-Hodgman), remembering which
-// corners are crossings of the two outlines; the line through the two crossings farthest
-// apart gives the normal, its midpoint the force point.
+// p clipped by the edges of q near the contact (Sutherland-Hodgman), remembering for
+// each corner of the overlap the line its outgoing edge lies on (an edge of p or of q).
+// A corner between two lines of p is a corner of p, between two of q one of q, between
+// one of each a crossing of the outlines: the three origins src/overlap.rs tags. The
+// line through the two crossings farthest apart gives the normal, its midpoint the
+// force point.
 //
-// A pair is computed in a frame centred between the two particles: corners are
-// -+ (c_j - c_i)/2 + R(theta)v, with the exact fixed-point offset rounded once to f32;
-// a wall contact in particle i's frame. Corner coordinates then carry ~3e-8 d of
-// rounding, so an area overlap A/l is resolved to about 1e-7 d (README, "Precision").
+// Precision (SPEC 3; README "Precision"). Corners are whole position units in a frame
+// at particle j's centre (exact: the fixed-point offset and corners rotated in integers,
+// orientation.wgsl) plus small f32 remainders. The clipping runs in f32, in units, in a
+// frame centred between the pair: it finds the lines that bound the overlap, the
+// crossings, the force point and the normal to ~3e-8 d, plenty for them. Not for the
+// area: a resting contact is a sliver ~1e-5 d thin, and f32 corners half a diameter out
+// carry 3e-8 d. So `exact_area` computes it again from the lines, in a frame along the
+// contact line: each overlap corner's distance w from that line comes from exact 64-bit
+// integer dot and cross products (a corner of p or q directly; a crossing by
+// interpolating along whichever of its two edges is flatter, from the nearer end), and
+// A = 1/2 sum (w_k + w_k+1)(u_k - u_k+1) needs the coordinates u along the line only to
+// f32. A/l is then right to ~1e-9 d however thin the overlap.
 
 const MAX_CLIP: u32 = 36u;
 
@@ -17,11 +28,18 @@ override POLYGONS: bool = false;
 const ORIGIN_P: u32 = 0u;
 const ORIGIN_Q: u32 = 1u;
 const ORIGIN_CROSSING: u32 = 2u;
+// Line ids: edge m of p (corner m to m + 1) is m, edge m of q is Q_LINE + m; then a
+// wall's line and the lines across its two ends.
+const Q_LINE: u32 = 16u;
+const WALL_LINE: u32 = 32u;
+const END_A_LINE: u32 = 33u;
+const END_B_LINE: u32 = 34u;
+const Q30: f32 = 1073741824.0;
 
 struct AreaContact {
     area: f32,
     n: vec2<f32>,       // from j to i
-    point: vec2<f32>,   // force point S, relative to centre i
+    point: vec2<f32>,   // force point S
     chord: f32,
     l: f32,
     found: bool,
@@ -31,43 +49,48 @@ fn no_contact() -> AreaContact {
     return AreaContact(0.0, vec2<f32>(0.0, 1.0), vec2<f32>(0.0), 0.0, 0.0, false);
 }
 
-// (sin x, cos x) to about one ulp. Vulkan only requires sin and cos to be within 2^-11
-// absolutely, and GPUs use fast hardware approximations (~4e-7): on a corner half a
-// diameter out that would be 2e-7 d, more than the whole f32 budget of the overlap.
-// Range reduction by quarter turns (pi/2 in two parts, the first product exact for the
-// small multiples that occur: polygon angles are kept in [-pi, pi]), then Taylor series
-// on [-pi/4, pi/4] (next terms below 2e-9).
-fn sin_cos(x: f32) -> vec2<f32> {
-    let q = round(x * 0.63661977236758134);
-    let r = (x - q * 1.5707963705062866) + q * 4.37113900018624283e-8;
-    let r2 = r * r;
-    let s = r * (1.0 + r2 * (-1.0 / 6.0 + r2 * (1.0 / 120.0 + r2 * (-1.0 / 5040.0 + r2 * (1.0 / 362880.0)))));
-    let c = 1.0 + r2 * (-0.5 + r2 * (1.0 / 24.0 + r2 * (-1.0 / 720.0 + r2 * (1.0 / 40320.0 + r2 * (-1.0 / 3628800.0)))));
-    let k = (i32(q) % 4 + 4) % 4;
-    if (k == 0) { return vec2<f32>(s, c); }
-    if (k == 1) { return vec2<f32>(c, -s); }
-    if (k == 2) { return vec2<f32>(-s, -c); }
-    return vec2<f32>(-c, s);
-}
+// A polygon in a contact frame: corners in whole units `w`, an f32 remainder `e`
+// shared by all, and the orientation remainder `spin` (turn units) about the centre
+// `base`, whose first-order turn of each corner is added in f32.
+struct Outline {
+    w: array<vec2<i32>, 16>,
+    n: u32,
+    base: vec2<i32>,
+    e: vec2<f32>,
+    spin: f32,
+};
 
-// Corners of particle k in the world orientation, shifted by `centre`.
-fn load_polygon(k: u32, centre: vec2<f32>, out: ptr<function, array<vec2<f32>, 16>>) -> u32 {
+fn load_outline(k: u32, base: vec2<i32>, e: vec2<f32>, o: ptr<function, Outline>) {
     let sh = props[k].shape;
-    let sc = sin_cos(state[k].q[0].z);
-    let c = sc.y;
-    let s = sc.x;
-    for (var m = 0u; m < sh.y; m++) {
-        let v = corners[sh.x + m];
-        (*out)[m] = centre + vec2<f32>(c * v.x - s * v.y, s * v.x + c * v.y);
-    }
-    return sh.y;
+    for (var m = 0u; m < sh.y; m++) { (*o).w[m] = base + corners[sh.x + m].zw; }
+    (*o).n = sh.y;
+    (*o).base = base;
+    (*o).e = e;
+    (*o).spin = state[k].q[0].z;
 }
 
-fn shoelace(v: ptr<function, array<array<vec2<f32>, MAX_CLIP>, 2>>, b: u32, n: u32) -> f32 {
+// The remainder of corner m (units).
+fn corner_e(o: ptr<function, Outline>, m: u32) -> vec2<f32> {
+    return (*o).e + corner_spin((*o).w[m] - (*o).base, (*o).spin);
+}
+
+// Corner m in f32 units relative to the point h of the frame.
+fn corner_at(o: ptr<function, Outline>, m: u32, h: vec2<i32>) -> vec2<f32> {
+    return vec2<f32>((*o).w[m] - h) + corner_e(o, m);
+}
+
+// The polygon being clipped: corners and the line of each corner's outgoing edge, in
+// two buffers that alternate.
+struct Clip {
+    v: array<array<vec2<f32>, MAX_CLIP>, 2>,
+    line: array<array<u32, MAX_CLIP>, 2>,
+};
+
+fn shoelace(c: ptr<function, Clip>, b: u32, n: u32) -> f32 {
     var a = 0.0;
     for (var k = 0u; k < n; k++) {
-        let p = (*v)[b][k];
-        let q = (*v)[b][(k + 1u) % n];
+        let p = (*c).v[b][k];
+        let q = (*c).v[b][(k + 1u) % n];
         a += p.x * q.y - q.x * p.y;
     }
     return 0.5 * a;
@@ -75,10 +98,10 @@ fn shoelace(v: ptr<function, array<array<vec2<f32>, MAX_CLIP>, 2>>, b: u32, n: u
 
 // Mean of the corners: the fallback force point. Unlike the area centroid it needs no
 // division by a vanishing area, so a degenerate overlap keeps S inside it.
-fn corner_mean(v: ptr<function, array<array<vec2<f32>, MAX_CLIP>, 2>>, b: u32, n: u32) -> vec2<f32> {
-    var c = vec2<f32>(0.0);
-    for (var k = 0u; k < n; k++) { c += (*v)[b][k]; }
-    return c / f32(n);
+fn corner_mean(c: ptr<function, Clip>, b: u32, n: u32) -> vec2<f32> {
+    var s = vec2<f32>(0.0);
+    for (var k = 0u; k < n; k++) { s += (*c).v[b][k]; }
+    return s / f32(n);
 }
 
 fn reduced_arm(li: f32, lj: f32, scale: f32) -> f32 {
@@ -88,63 +111,195 @@ fn reduced_arm(li: f32, lj: f32, scale: f32) -> f32 {
     return a * b / (a + b);
 }
 
-// Area contact of polygon p (np corners, centre ci) with polygon q (nq corners, centre
-// cj); the force point comes back in the same frame.
-fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32, ci: vec2<f32>,
-                   q: ptr<function, array<vec2<f32>, 16>>, nq: u32, cj: vec2<f32>,
-                   only_area: bool) -> AreaContact {
-    var v: array<array<vec2<f32>, MAX_CLIP>, 2>;
-    var origin: array<array<u32, MAX_CLIP>, 2>;   // origin | (on p's outline) << 2
-    var count = array<u32, 2>(np, 0u);
+// Clips polygon src (n corners) by the half-plane (x - a).m >= 0 into 1 - src; the
+// clip line has id `id`. Leaving the half-plane the outline follows the clip line,
+// entering it the edge.
+fn clip_lines(c: ptr<function, Clip>, src: u32, n: u32, a: vec2<f32>, m: vec2<f32>, id: u32) -> u32 {
+    let dst = 1u - src;
+    var out = 0u;
+    for (var e = 0u; e < n; e++) {
+        let x = (*c).v[src][e];
+        let y = (*c).v[src][(e + 1u) % n];
+        let dx = dot(x - a, m);
+        let dy = dot(y - a, m);
+        if (dx >= 0.0 && out < MAX_CLIP) {
+            (*c).v[dst][out] = x;
+            (*c).line[dst][out] = (*c).line[src][e];
+            out++;
+        }
+        if ((dx >= 0.0) != (dy >= 0.0) && out < MAX_CLIP) {
+            (*c).v[dst][out] = x + (dx / (dx - dy)) * (y - x);
+            (*c).line[dst][out] = select((*c).line[src][e], id, dx >= 0.0);
+            out++;
+        }
+    }
+    return out;
+}
+
+fn origin_of(line_in: u32, line_out: u32) -> u32 {
+    let pin = line_in < Q_LINE;
+    let pout = line_out < Q_LINE;
+    if (pin && pout) { return ORIGIN_P; }
+    if (!pin && !pout) { return ORIGIN_Q; }
+    return ORIGIN_CROSSING;
+}
+
+// --- exact distances from the contact line ---
+
+// The frame of `exact_area`: the point o (whole units; `at` in clip coordinates) on
+// the contact line, its unit normal n in f32 and in Q30 integers, and the direction t
+// along the line; (t, n) is right-handed. Clip coordinates are relative to h.
+struct Frame {
+    o: vec2<i32>,
+    nq: vec2<i32>,
+    n: vec2<f32>,
+    t: vec2<f32>,
+    at: vec2<f32>,
+    h: vec2<i32>,
+};
+
+fn make_frame(h: vec2<i32>, s: vec2<f32>, n: vec2<f32>) -> Frame {
+    let o = h + vec2<i32>(round(s));
+    return Frame(o, vec2<i32>(round(n * Q30)), n, vec2<f32>(n.y, -n.x), vec2<f32>(o - h), h);
+}
+
+// (u, w) of corner m: u along the line from f32 (it only needs to be right relative
+// to the overlap's length), w exact.
+fn corner_uw(o: ptr<function, Outline>, m: u32, fr: Frame) -> vec2<f32> {
+    return vec2<f32>(dot(corner_at(o, m, fr.h) - fr.at, fr.t), corner_w(o, m, fr));
+}
+
+// (x - o).n of corner m, from an exact 64-bit dot product.
+fn corner_w(o: ptr<function, Outline>, m: u32, fr: Frame) -> f32 {
+    let d = (*o).w[m] - fr.o;
+    let exact = add64(smul(d.x, fr.nq.x), smul(d.y, fr.nq.y));
+    return i64_to_f32(exact) / Q30 + dot(corner_e(o, m), fr.n);
+}
+
+// (b - a) x (x - a) of three corners (whole units and remainders), the large part exact
+// in 64-bit integers and the remainders to first order.
+fn cross_units(aw: vec2<i32>, ae: vec2<f32>, bw: vec2<i32>, be: vec2<f32>,
+               xw: vec2<i32>, xe: vec2<f32>) -> f32 {
+    let ab = bw - aw;
+    let ax = xw - aw;
+    let exact = sub64(smul(ab.x, ax.y), smul(ab.y, ax.x));
+    let abe = be - ae;
+    let axe = xe - ae;
+    return i64_to_f32(exact) + (f32(ab.x) * axe.y - f32(ab.y) * axe.x)
+        + (abe.x * f32(ax.y) - abe.y * f32(ax.x));
+}
+
+// Where a segment whose ends are at signed distances dx, dy crosses a line (0 at x).
+fn crossing_param(dx: f32, dy: f32) -> f32 {
+    if (dx == dy) { return 0.5; }
+    return clamp(dx / (dx - dy), 0.0, 1.0);
+}
+
+// w at parameter s between ends with wx, wy, from the nearer end; and the size of its
+// error in units of the parameter's relative error.
+fn interpolate_w(wx: f32, wy: f32, s: f32) -> vec2<f32> {
+    if (s <= 0.5) { return vec2<f32>(wx + s * (wy - wx), s * abs(wy - wx)); }
+    return vec2<f32>(wy + (1.0 - s) * (wx - wy), (1.0 - s) * abs(wy - wx));
+}
+
+// (u, w) of the crossing of p's edge mp with q's edge mq, interpolated along the
+// flatter of the two with the exact crossing parameter. (The f32 clip's crossing of two
+// nearly parallel edges can be far off along them: its u is not used.)
+fn crossing_uw(p: ptr<function, Outline>, mp: u32, q: ptr<function, Outline>, mq: u32,
+               fr: Frame) -> vec2<f32> {
+    let x = mp;
+    let y = (mp + 1u) % (*p).n;
+    let a = mq;
+    let b = (mq + 1u) % (*q).n;
+    let xw = (*p).w[x];
+    let yw = (*p).w[y];
+    let aw = (*q).w[a];
+    let bw = (*q).w[b];
+    let xe = corner_e(p, x);
+    let ye = corner_e(p, y);
+    let ae = corner_e(q, a);
+    let be = corner_e(q, b);
+    let s = crossing_param(cross_units(aw, ae, bw, be, xw, xe), cross_units(aw, ae, bw, be, yw, ye));
+    let r = crossing_param(cross_units(xw, xe, yw, ye, aw, ae), cross_units(xw, xe, yw, ye, bw, be));
+    let px = corner_uw(p, x, fr);
+    let py = corner_uw(p, y, fr);
+    let qa = corner_uw(q, a, fr);
+    let qb = corner_uw(q, b, fr);
+    let on_p = interpolate_w(px.y, py.y, s);
+    let on_q = interpolate_w(qa.y, qb.y, r);
+    if (on_p.y <= on_q.y) { return vec2<f32>(interpolate_w(px.x, py.x, s).x, on_p.x); }
+    return vec2<f32>(interpolate_w(qa.x, qb.x, r).x, on_q.x);
+}
+
+// (u, w) of overlap corner k, between lines lin and lout (x: its f32 clip position).
+fn vertex_uw(p: ptr<function, Outline>, q: ptr<function, Outline>, c: ptr<function, Clip>,
+             b: u32, n: u32, k: u32, fr: Frame) -> vec2<f32> {
+    let lin = (*c).line[b][(k + n - 1u) % n];
+    let lout = (*c).line[b][k];
+    let pin = lin < Q_LINE;
+    let pout = lout < Q_LINE;
+    if (pin && pout && lout == (lin + 1u) % (*p).n) { return corner_uw(p, lout, fr); }
+    if (!pin && !pout && lout - Q_LINE == (lin - Q_LINE + 1u) % (*q).n) {
+        return corner_uw(q, lout - Q_LINE, fr);
+    }
+    if (pin && !pout) { return crossing_uw(p, lin, q, lout - Q_LINE, fr); }
+    if (!pin && pout) { return crossing_uw(p, lout, q, lin - Q_LINE, fr); }
+    // Two lines of one polygon that are not neighbours: a degenerate clip, in f32.
+    let x = (*c).v[b][k] - fr.at;
+    return vec2<f32>(dot(x, fr.t), dot(x, fr.n));
+}
+
+// The overlap's area (units^2) from its lines: 1/2 sum (w_k + w_k+1)(u_k - u_k+1).
+fn exact_area(p: ptr<function, Outline>, q: ptr<function, Outline>, c: ptr<function, Clip>,
+              b: u32, n: u32, fr: Frame) -> f32 {
+    let first = vertex_uw(p, q, c, b, n, 0u, fr);
+    var prev = first;
+    var a = 0.0;
+    for (var k = 1u; k <= n; k++) {
+        var x = first;
+        if (k < n) { x = vertex_uw(p, q, c, b, n, k, fr); }
+        a += (prev.y + x.y) * (prev.x - x.x);
+        prev = x;
+    }
+    return 0.5 * a;
+}
+
+// --- polygon against polygon, polygon against wall ---
+
+// Area contact of polygon p (centre ci) with polygon q (centre cj), in clip
+// coordinates: f32 units relative to the frame point h. Area in units^2.
+fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2<i32>,
+                   ci: vec2<f32>, cj: vec2<f32>, only_area: bool) -> AreaContact {
+    var c: Clip;
+    var count = array<u32, 2>((*p).n, 0u);
     var r2 = 0.0;
-    for (var k = 0u; k < np; k++) {
-        v[0][k] = (*p)[k];
-        origin[0][k] = ORIGIN_P | 4u;
-        r2 = max(r2, dot((*p)[k] - ci, (*p)[k] - ci));
+    for (var k = 0u; k < (*p).n; k++) {
+        let x = corner_at(p, k, h);
+        c.v[0][k] = x;
+        c.line[0][k] = k;
+        r2 = max(r2, dot(x - ci, x - ci));
     }
     let r = sqrt(r2);
     var cur = 0u;
+    let nq = (*q).n;
+    var a = corner_at(q, 0u, h);
     for (var k = 0u; k < nq; k++) {
-        let a = (*q)[k];
-        let b = (*q)[(k + 1u) % nq];
+        let b = corner_at(q, (k + 1u) % nq, h);
         let m = vec2<f32>(-(b.y - a.y), b.x - a.x);
         let reach = r * length(m);
         let centre = dot(ci - a, m);
+        let start = a;
+        a = b;
+        // Edges whose half-plane holds all of p's circle change nothing.
         if (centre >= reach) { continue; }
         if (centre <= -reach) { count[cur] = 0u; break; }
-        let dst = 1u - cur;
-        var out = 0u;
-        let n = count[cur];
-        for (var e = 0u; e < n; e++) {
-            let x = v[cur][e];
-            let y = v[cur][(e + 1u) % n];
-            let dx = dot(x - a, m);
-            let dy = dot(y - a, m);
-            let on_p = (origin[cur][e] & 4u) != 0u;
-            if (dx >= 0.0 && out < MAX_CLIP) {
-                v[dst][out] = x;
-                origin[dst][out] = origin[cur][e];
-                out++;
-            }
-            if ((dx >= 0.0) != (dy >= 0.0) && out < MAX_CLIP) {
-                let t = dx / (dx - dy);
-                v[dst][out] = x + t * (y - x);
-                var o = ORIGIN_Q;
-                if (on_p) { o = ORIGIN_CROSSING; }
-                // Leaving the half-plane the outline follows q's line; entering, the edge.
-                var keep = on_p;
-                if (dx >= 0.0) { keep = false; }
-                origin[dst][out] = o | select(0u, 4u, keep);
-                out++;
-            }
-        }
-        count[dst] = out;
-        cur = dst;
-        if (out == 0u) { break; }
+        count[1u - cur] = clip_lines(&c, cur, count[cur], start, m, Q_LINE + k);
+        cur = 1u - cur;
+        if (count[cur] == 0u) { break; }
     }
     let n = count[cur];
     if (n < 3u) { return no_contact(); }
-    let area = shoelace(&v, cur, n);
+    let area = shoelace(&c, cur, n);
     if (area <= 0.0) { return no_contact(); }
     var g = no_contact();
     g.area = area;
@@ -154,12 +309,14 @@ fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32, ci: vec2<f32
     var best = -1.0;
     var xa = vec2<f32>(0.0);
     var xb = vec2<f32>(0.0);
-    for (var a = 0u; a < n; a++) {
-        if ((origin[cur][a] & 3u) != ORIGIN_CROSSING) { continue; }
-        for (var b = a + 1u; b < n; b++) {
-            if ((origin[cur][b] & 3u) != ORIGIN_CROSSING) { continue; }
-            let d = length(v[cur][b] - v[cur][a]);
-            if (d > best) { best = d; xa = v[cur][a]; xb = v[cur][b]; }
+    var ia = 0u;
+    var ib = 0u;
+    for (var i = 0u; i < n; i++) {
+        if (origin_of(c.line[cur][(i + n - 1u) % n], c.line[cur][i]) != ORIGIN_CROSSING) { continue; }
+        for (var j = i + 1u; j < n; j++) {
+            if (origin_of(c.line[cur][j - 1u], c.line[cur][j]) != ORIGIN_CROSSING) { continue; }
+            let d = length(c.v[cur][j] - c.v[cur][i]);
+            if (d > best) { best = d; xa = c.v[cur][i]; xb = c.v[cur][j]; ia = i; ib = j; }
         }
     }
     let scale = length(cj - ci) + r;
@@ -173,70 +330,75 @@ fn polygon_polygon(p: ptr<function, array<vec2<f32>, 16>>, np: u32, ci: vec2<f32
         // Corners of i inside j lie on j's side of the line, corners of j on i's side.
         var side = 0.0;
         for (var k = 0u; k < n; k++) {
-            let o = origin[cur][k] & 3u;
-            if (o == ORIGIN_P) { side += dot(nn, v[cur][k] - s); }
-            if (o == ORIGIN_Q) { side -= dot(nn, v[cur][k] - s); }
+            let o = origin_of(c.line[cur][(k + n - 1u) % n], c.line[cur][k]);
+            if (o == ORIGIN_P) { side += dot(nn, c.v[cur][k] - s); }
+            if (o == ORIGIN_Q) { side -= dot(nn, c.v[cur][k] - s); }
         }
         if (side > 0.0 || (side == 0.0 && dot(nn, ci - cj) < 0.0)) { nn = -nn; }
-        g.n = nn;
-        g.point = s;
-        g.chord = chord;
+        // The crossings again, exact: one between two nearly parallel edges is poorly
+        // placed along them by the f32 clip.
+        let fr = make_frame(h, s, nn);
+        let ua = vertex_uw(p, q, &c, cur, n, ia, fr);
+        let ub = vertex_uw(p, q, &c, cur, n, ib, fr);
+        let d = ub - ua;
+        let len = length(d);
+        if (len > 1.0e-6 * scale) {
+            let tt = (d.x * fr.t + d.y * fr.n) / len;
+            g.n = vec2<f32>(-tt.y, tt.x) * sign(dot(vec2<f32>(-tt.y, tt.x), nn));
+            g.chord = len;
+            let mid = 0.5 * (ua + ub);
+            g.point = fr.at + mid.x * fr.t + mid.y * fr.n;
+        } else {
+            g.n = nn;
+            g.point = s;
+            g.chord = chord;
+        }
+        g.area = max(exact_area(p, q, &c, cur, n, fr), 0.0);
     } else {
         g.n = along;
-        g.point = corner_mean(&v, cur, n);
+        g.point = corner_mean(&c, cur, n);
         g.chord = 0.0;
+        g.area = max(exact_area(p, q, &c, cur, n, make_frame(h, g.point, g.n)), 0.0);
     }
     g.l = reduced_arm(length(g.point - ci), length(g.point - cj), scale);
     return g;
 }
 
-// Clips polygon v[src] (n corners) by the half-plane (x - a).m >= 0 into v[1 - src].
-fn clip_plain(v: ptr<function, array<array<vec2<f32>, MAX_CLIP>, 2>>, src: u32, n: u32,
-              a: vec2<f32>, m: vec2<f32>) -> u32 {
-    let dst = 1u - src;
-    var out = 0u;
-    for (var e = 0u; e < n; e++) {
-        let x = (*v)[src][e];
-        let y = (*v)[src][(e + 1u) % n];
-        let dx = dot(x - a, m);
-        let dy = dot(y - a, m);
-        if (dx >= 0.0 && out < MAX_CLIP) { (*v)[dst][out] = x; out++; }
-        if ((dx >= 0.0) != (dy >= 0.0) && out < MAX_CLIP) {
-            (*v)[dst][out] = x + (dx / (dx - dy)) * (y - x);
-            out++;
-        }
-    }
-    return out;
-}
-
-// Area contact of polygon p (centre 0) with the wall segment wa-wb (relative to the
-// centre): the part of p beyond the wall's line and between its end points.
-fn polygon_wall(p: ptr<function, array<vec2<f32>, 16>>, np: u32, wa: vec2<f32>, wb: vec2<f32>,
+// Area contact of polygon p (centre at the origin, clip coordinates in units) with the
+// wall segment wa-wb: the part of p beyond the wall's line and between its end points.
+// For an axis-aligned wall whose line is exact in `oa` (the offset of its end a) the
+// area is recomputed exactly: w is then a corner's exact distance from the wall's line,
+// zero on it, and interpolated along p's edge where an edge crosses an end line.
+fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, oa: Offset,
                 only_area: bool) -> AreaContact {
     let ab = wb - wa;
     let len = length(ab);
     if (len == 0.0) { return no_contact(); }
     var m = vec2<f32>(-ab.y, ab.x) / len;
     if (dot(m, -wa) < 0.0) { m = -m; }
-    var v: array<array<vec2<f32>, MAX_CLIP>, 2>;
-    for (var k = 0u; k < np; k++) { v[0][k] = (*p)[k]; }
-    var n = clip_plain(&v, 0u, np, wa, -m);
-    n = clip_plain(&v, 1u, n, wa, ab);
-    n = clip_plain(&v, 0u, n, wb, -ab);
+    var c: Clip;
+    let np = (*p).n;
+    for (var k = 0u; k < np; k++) {
+        c.v[0][k] = corner_at(p, k, vec2<i32>(0));
+        c.line[0][k] = k;
+    }
+    var n = clip_lines(&c, 0u, np, wa, -m, WALL_LINE);
+    n = clip_lines(&c, 1u, n, wa, ab, END_A_LINE);
+    n = clip_lines(&c, 0u, n, wb, -ab, END_B_LINE);
     if (n < 3u) { return no_contact(); }
-    let area = shoelace(&v, 1u, n);
+    let area = shoelace(&c, 1u, n);
     if (area <= 0.0) { return no_contact(); }
     var g = no_contact();
     g.area = area;
     g.found = true;
     if (only_area) { return g; }
     var r = 0.0;
-    for (var k = 0u; k < np; k++) { r = max(r, length((*p)[k])); }
+    for (var k = 0u; k < np; k++) { r = max(r, length(corner_at(p, k, vec2<i32>(0)))); }
     let scale = len + r;
     var lo = 3.0e38;
     var hi = -3.0e38;
     for (var k = 0u; k < n; k++) {
-        let x = v[1][k];
+        let x = c.v[1][k];
         if (abs(dot(x - wa, m)) <= 1.0e-6 * scale) {
             let s = dot(x - wa, ab) / len;
             lo = min(lo, s);
@@ -248,34 +410,123 @@ fn polygon_wall(p: ptr<function, array<vec2<f32>, 16>>, np: u32, wa: vec2<f32>, 
         g.point = wa + (0.5 * (lo + hi) / len) * ab;
         g.chord = hi - lo;
     } else {
-        g.point = corner_mean(&v, 1u, n);
+        g.point = corner_mean(&c, 1u, n);
         g.chord = 0.0;
     }
     g.l = max(length(g.point), 1.0e-6 * scale);
+    // Exact for an axis-aligned wall: the normal along axis k, the wall's line exact in
+    // oa. The area as for two polygons, with w a corner's distance from the wall's line
+    // (zero on it); the chord from the crossings' u, interpolated with exact parameters.
+    let k = select(0u, 1u, ab.y == 0.0);
+    if ((ab.x == 0.0 || ab.y == 0.0) && abs(oa.da[k]) <= 1) {
+        let sign = m[k];
+        let t = vec2<f32>(m.y, -m.x);
+        let first = wall_uw(p, &c, n, 0u, oa, k, sign, t);
+        var prev = first;
+        var a = 0.0;
+        var lo2 = 3.0e38;
+        var hi2 = -3.0e38;
+        for (var e = 1u; e <= n; e++) {
+            var x = first;
+            if (e < n) { x = wall_uw(p, &c, n, e, oa, k, sign, t); }
+            a += (prev.y + x.y) * (prev.x - x.x);
+            if (x.z > 0.0) { lo2 = min(lo2, x.x); hi2 = max(hi2, x.x); }
+            prev = x;
+        }
+        g.area = max(0.5 * a, 0.0);
+        if (hi2 > lo2) {
+            g.chord = hi2 - lo2;
+            g.point = (0.5 * (lo2 + hi2)) * t + dot(wa, m) * m;
+            g.l = max(length(g.point), 1.0e-6 * scale);
+        }
+    }
     return g;
 }
 
-// The area contact of particle i with particle j (both polygons). It is computed in a
-// frame centred between them, where the corners that meet are smallest, and the force
-// point is returned relative to centre i.
+// (u, w, on the wall's line) of corner e of the clipped polygon (buffer 1), for an
+// axis-aligned wall (normal `sign` along axis k, t along the wall).
+fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, oa: Offset,
+           k: u32, sign: f32, t: vec2<f32>) -> vec3<f32> {
+    let lin = (*c).line[1][(e + n - 1u) % n];
+    let lout = (*c).line[1][e];
+    let np = (*p).n;
+    let at = (*c).v[1][e];
+    var edge = lout;
+    if (lin < Q_LINE) { edge = lin; }
+    if (lin == WALL_LINE || lout == WALL_LINE) {
+        if (edge < Q_LINE) {
+            // An edge of p across the wall's line, at the exact parameter.
+            let y = (edge + 1u) % np;
+            let wx = corner_wall_w(p, edge, oa, k, sign);
+            let wy = corner_wall_w(p, y, oa, k, sign);
+            let s = crossing_param(wx, wy);
+            let u = interpolate_w(dot(corner_at(p, edge, vec2<i32>(0)), t),
+                                  dot(corner_at(p, y, vec2<i32>(0)), t), s).x;
+            return vec3<f32>(u, 0.0, 1.0);
+        }
+        return vec3<f32>(dot(at, t), 0.0, 1.0);   // an end point of the wall
+    }
+    if (lin < Q_LINE && lout < Q_LINE && lout == (lin + 1u) % np) {
+        return vec3<f32>(dot(at, t), corner_wall_w(p, lout, oa, k, sign), 0.0);
+    }
+    if (edge < Q_LINE) {
+        // An edge of p across an end line: along the edge, from its nearer end.
+        let y = (edge + 1u) % np;
+        let xf = corner_at(p, edge, vec2<i32>(0));
+        let d = corner_at(p, y, vec2<i32>(0)) - xf;
+        let s = clamp(dot(at - xf, d) / max(dot(d, d), 1.0e-30), 0.0, 1.0);
+        let w = interpolate_w(corner_wall_w(p, edge, oa, k, sign), corner_wall_w(p, y, oa, k, sign), s).x;
+        return vec3<f32>(dot(at, t), w, 0.0);
+    }
+    return vec3<f32>(dot(at, t), sign * (at[k] - (vec2<f32>(oa.d) + oa.e)[k]), 0.0);
+}
+
+fn corner_wall_w(p: ptr<function, Outline>, m: u32, oa: Offset, k: u32, sign: f32) -> f32 {
+    return sign * (f32((*p).w[m][k] - oa.d[k]) + (corner_e(p, m)[k] - oa.e[k]));
+}
+
+// The area contact of particle i with particle j (both polygons), in length units with
+// the force point relative to centre i. Corners are exact in a frame at j's centre and
+// clipped in f32 relative to the middle of the pair.
 fn polygons_ij(i: u32, j: u32, only_area: bool) -> AreaContact {
-    var p: array<vec2<f32>, 16>;
-    var q: array<vec2<f32>, 16>;
-    let half = -0.5 * offset_vector(offset_ij(i, j));
-    let np = load_polygon(i, -half, &p);
-    let nq = load_polygon(j, half, &q);
-    var g = polygon_polygon(&p, np, -half, &q, nq, half, only_area);
-    g.point += half;
+    let o = offset_ij(i, j);
+    // Centres more than 1.5 cells apart cannot touch (and their corners would not fit
+    // an i32 in the frame).
+    if (!o.near || any(abs(o.d) > vec2<i32>(1610612736))) { return no_contact(); }
+    var p: Outline;
+    var q: Outline;
+    load_outline(i, o.d, o.e, &p);
+    load_outline(j, vec2<i32>(0), vec2<f32>(0.0), &q);
+    let h = o.d / vec2<i32>(2);
+    let ci = vec2<f32>(o.d - h) + o.e;
+    var g = polygon_polygon(&p, &q, h, ci, vec2<f32>(-h), only_area);
+    let u = params.unit;
+    g.area *= u * u;
+    g.chord *= u;
+    g.l *= u;
+    g.point = (g.point - ci) * u;
     return g;
 }
 
-// The area contact of particle i with wall w, in i's frame.
+// An offset in f32 units (exact when near, else to f32 precision).
+fn offset_units(o: Offset) -> vec2<f32> {
+    if (o.near) { return vec2<f32>(o.d) + o.e; }
+    return offset_vector(o) * params.inv_unit;
+}
+
+// The area contact of particle i with wall w, in length units in i's frame.
 fn polygon_wall_iw(i: u32, w: u32, only_area: bool) -> AreaContact {
-    var p: array<vec2<f32>, 16>;
-    let np = load_polygon(i, vec2<f32>(0.0), &p);
     let s = state[i];
     let wall = walls[w];
     let oa = offset(wall.a_anchor, wall.a_frac, wall.a_rem, s.anchor, s.frac, s.q[0].xy);
     let ob = offset(wall.b_anchor, wall.b_frac, wall.b_rem, s.anchor, s.frac, s.q[0].xy);
-    return polygon_wall(&p, np, offset_vector(oa), offset_vector(ob), only_area);
+    var p: Outline;
+    load_outline(i, vec2<i32>(0), vec2<f32>(0.0), &p);
+    var g = polygon_wall(&p, offset_units(oa), offset_units(ob), oa, only_area);
+    let u = params.unit;
+    g.area *= u * u;
+    g.chord *= u;
+    g.l *= u;
+    g.point *= u;
+    return g;
 }

@@ -140,13 +140,3 @@ fn displace(s: ptr<function, State>, by: vec2<f32>) {
     let r = (*s).q[0].xy + by * params.inv_unit;
     (*s).q[0] = vec4<f32>(r, (*s).q[0].zw);
 }
-
-// Keeps a polygon's orientation in [-pi, pi], where f32 resolves 2.4e-7 rad (a corner
-// moves 1e-7 d), instead of letting a rolling grain's angle grow until its corners blur.
-// 2 pi = 6.28125 + 0.0019353071795864769: the first subtraction is exact.
-fn wrap_angle(s: ptr<function, State>) {
-    var th = (*s).q[0].z;
-    if (th > 3.14159265) { th = (th - 6.28125) - 0.0019353071795864769; }
-    if (th < -3.14159265) { th = (th + 6.28125) + 0.0019353071795864769; }
-    (*s).q[0].z = th;
-}

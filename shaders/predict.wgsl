@@ -8,7 +8,7 @@ fn predict_one(s: ptr<function, State>) {
     let q4 = (*s).q[4];
     let q5 = (*s).q[5];
     let step = q1 + q2 + q3 + q4 + q5;
-    (*s).q[0].z += step.z;
+    turn_by(s, step.z);
     displace(s, step.xy);
     (*s).q[1] += 2.0 * q2 + 3.0 * q3 + 4.0 * q4 + 5.0 * q5;
     (*s).q[2] += 3.0 * q3 + 6.0 * q4 + 10.0 * q5;
@@ -23,6 +23,8 @@ fn predict(@builtin(global_invocation_id) gid: vec3<u32>) {
     var s = state[i];
     predict_one(&s);
     renormalize(&s);
-    if (props[i].shape.y > 0u) { wrap_angle(&s); }
+    renormalize_turn(&s);
     state[i] = s;
+    // Forces are evaluated at the predicted state.
+    rotate_corners(i, s);
 }

@@ -14,7 +14,7 @@ const MAGIC: &[u8; 8] = b"TALUSCK2";
 /// Checkpoints of talus before polygons (no shapes): named in the error.
 const OLD_MAGIC: &[u8; 8] = b"TALUSCK1";
 /// Version of the raw device arrays a GPU checkpoint carries (fixed-point positions).
-const DEVICE_LAYOUT: u8 = 2;
+const DEVICE_LAYOUT: u8 = 3;
 
 #[derive(Debug, thiserror::Error)]
 pub enum CheckpointError {
@@ -73,7 +73,8 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
     sim.springs.keys.iter().for_each(|&k| e.u64(k));
     sim.springs.values.iter().for_each(|&v| e.f64(v));
     // From a GPU run: the exact device state, for a bitwise GPU resume. The flag is the
-    // device layout's version (1: f32 offsets before fixed point; no longer read).
+    // device layout's version (1: f32 offsets before fixed point, 2: f32 orientations;
+    // neither is read any more).
     match &sim.device_state {
         Some(ds) => {
             e.u8(DEVICE_LAYOUT);

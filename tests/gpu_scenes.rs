@@ -138,6 +138,7 @@ fn pair_force_difference(gs: &Simulation, cpu: &Simulation) -> (f64, f64, usize,
     };
     let (fg, fc) = (forces(gs), forces(cpu));
     let mean = fc.values().sum::<f64>() / fc.len() as f64;
+
     let worst = fg
         .keys()
         .chain(fc.keys())
@@ -378,10 +379,12 @@ fn gpu_polygon_runs_are_bitwise_reproducible_and_resume_bitwise() {
 #[test]
 fn polygon_pile_agrees_with_the_cpu() {
     // R8 reduced: 176 regular 12-gons face to face on the hexagonal lattice, gravity
-    // ramping in. Polygon geometry on the GPU is f32 in the frame of particle i: corners
-    // carry ~3e-8 d, so A/l is resolved to ~1e-7 d (README, "Precision"). The paper's
-    // k^n = 1e7 N/m gives overlaps of ~1e-6 d at 10 % gravity, below that; k^n = 1e5
-    // gives ~1e-4 d.
+    // ramping in, the whole step on both paths. The lattice's rows touch at exactly
+    // zero overlap, so which of those contacts exist is decided by rounding, and the
+    // two runs part by a fraction of the overlap: at the paper's k^n = 1e7 N/m (overlaps
+    // ~3e-7 d at 10 % gravity) by about half of it. k^n = 1e5 gives ~3e-5 d, where the
+    // runs stay together; the precision of the geometry itself at SI stiffness is
+    // tested pair by pair in gpu_kernels (`polygon_overlaps_are_exact_down_to_1e_6_d`).
     let scene = scene_file("r8_polygon_pile_reduced.json", &["contact.k_n=1e5"]);
     let d = 1.5e-3;
     let Some(mut g) = gpu_sim("polygon_pile_agrees_with_the_cpu", scene.clone()) else {
@@ -398,9 +401,10 @@ fn polygon_pile_agrees_with_the_cpu() {
         "polygon pile: {ng} vs {nc} contacts, positions {dp:.2e} d, normal forces {worst:.2e} of the mean, vertical sum {total:.2e}"
     );
     assert!(nc > 300, "the lattice is in contact: {nc}");
-    assert!(dp < 1e-6, "positions differ by {dp:.2e} d");
+    // Measured: 3.3e-8 d and 4.4e-4 of the mean force (2.6e-3 with f32 corners).
+    assert!(dp < 3e-7, "positions differ by {dp:.2e} d");
     assert!(
-        worst < 1e-2,
+        worst < 2e-3,
         "normal forces differ by {worst:.2e} of the mean"
     );
     assert!(total < 1e-3, "vertical force sum differs by {total:.2e}");

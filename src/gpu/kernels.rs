@@ -1,5 +1,5 @@
 //! The WGSL sources and their compute pipelines. Each stage file in `shaders/` is
-//! compiled after `common.wgsl`, `position.wgsl` and the helper files it uses; every pipeline shares one
+//! compiled after `common.wgsl`, `position.wgsl`, `orientation.wgsl` and the helper files it uses; every pipeline shares one
 //! pipeline layout (`common.wgsl`'s bindings), so a step binds its buffers once.
 
 /// A shader module: the stage file and the helper files it needs.
@@ -10,6 +10,7 @@ pub struct ModuleSource {
 
 const COMMON: &str = include_str!("../../shaders/common.wgsl");
 const POSITION: &str = include_str!("../../shaders/position.wgsl");
+const ORIENTATION: &str = include_str!("../../shaders/orientation.wgsl");
 const GEOMETRY: &str = include_str!("../../shaders/geometry.wgsl");
 const POLYGON: &str = include_str!("../../shaders/polygon.wgsl");
 const LAWS: &str = include_str!("../../shaders/laws.wgsl");
@@ -17,17 +18,28 @@ const LAWS: &str = include_str!("../../shaders/laws.wgsl");
 pub const MODULES: &[ModuleSource] = &[
     ModuleSource {
         name: "insert",
-        parts: &[COMMON, POSITION, include_str!("../../shaders/insert.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            ORIENTATION,
+            include_str!("../../shaders/insert.wgsl"),
+        ],
     },
     ModuleSource {
         name: "predict",
-        parts: &[COMMON, POSITION, include_str!("../../shaders/predict.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            ORIENTATION,
+            include_str!("../../shaders/predict.wgsl"),
+        ],
     },
     ModuleSource {
         name: "cell_index",
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             include_str!("../../shaders/cell_index.wgsl"),
         ],
     },
@@ -36,6 +48,7 @@ pub const MODULES: &[ModuleSource] = &[
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             include_str!("../../shaders/cell_histogram.wgsl"),
         ],
     },
@@ -44,18 +57,25 @@ pub const MODULES: &[ModuleSource] = &[
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             include_str!("../../shaders/prefix_sum.wgsl"),
         ],
     },
     ModuleSource {
         name: "scatter",
-        parts: &[COMMON, POSITION, include_str!("../../shaders/scatter.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            ORIENTATION,
+            include_str!("../../shaders/scatter.wgsl"),
+        ],
     },
     ModuleSource {
         name: "find_contacts",
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             GEOMETRY,
             POLYGON,
             include_str!("../../shaders/find_contacts.wgsl"),
@@ -66,6 +86,7 @@ pub const MODULES: &[ModuleSource] = &[
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             include_str!("../../shaders/gather_history.wgsl"),
         ],
     },
@@ -74,6 +95,7 @@ pub const MODULES: &[ModuleSource] = &[
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             GEOMETRY,
             POLYGON,
             LAWS,
@@ -85,6 +107,7 @@ pub const MODULES: &[ModuleSource] = &[
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             include_str!("../../shaders/store_history.wgsl"),
         ],
     },
@@ -93,18 +116,25 @@ pub const MODULES: &[ModuleSource] = &[
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             include_str!("../../shaders/reduce_forces.wgsl"),
         ],
     },
     ModuleSource {
         name: "correct",
-        parts: &[COMMON, POSITION, include_str!("../../shaders/correct.wgsl")],
+        parts: &[
+            COMMON,
+            POSITION,
+            ORIENTATION,
+            include_str!("../../shaders/correct.wgsl"),
+        ],
     },
     ModuleSource {
         name: "kick_drift",
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             include_str!("../../shaders/kick_drift.wgsl"),
         ],
     },
@@ -113,6 +143,7 @@ pub const MODULES: &[ModuleSource] = &[
         parts: &[
             COMMON,
             POSITION,
+            ORIENTATION,
             include_str!("../../shaders/boundaries.wgsl"),
         ],
     },

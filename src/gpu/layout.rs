@@ -80,7 +80,7 @@ pub struct Params {
     pub _pad: u32,
 }
 
-/// Dynamic state of one particle: q[0] = (rem_x, rem_z, θ, 0) and the scaled Gear
+/// Dynamic state of one particle: q[0] = (rem_x, rem_z, rem_θ, 0) and the scaled Gear
 /// derivatives q[1..6]; the position from the grid origin is
 /// `anchor · cell_size + (frac + rem) · unit` (see `position`).
 #[repr(C)]
@@ -89,6 +89,10 @@ pub struct State {
     pub q: [[f32; 4]; 6],
     pub anchor: [i32; 2],
     pub frac: [u32; 2],
+    /// Orientation in whole turn units of 2π/2³² (see `orientation`); the remainder is
+    /// q[0][2].
+    pub turn: u32,
+    pub _pad: [u32; 3],
 }
 
 #[repr(C)]
@@ -159,10 +163,11 @@ pub struct Candidate {
     pub flags: u32,
     pub radius_units: u32,
     pub radius_rem: f32,
-    /// Orientation and polygon corners (see `Props::shape`).
-    pub theta: f32,
+    /// Orientation (see `State::turn`) and polygon corners (see `Props::shape`).
+    pub turn: u32,
     pub shape: [u32; 2],
-    pub _pad: [u32; 2],
+    pub turn_rem: f32,
+    pub _pad: u32,
 }
 
 /// Field offsets of each struct, by WGSL member name, for the layout test.
@@ -222,7 +227,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 _pad
             ]
         ),
-        fields!(State, "State", [q, anchor, frac]),
+        fields!(State, "State", [q, anchor, frac, turn, _pad]),
         fields!(
             Props,
             "Props",
@@ -259,8 +264,9 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 flags,
                 radius_units,
                 radius_rem,
-                theta,
+                turn,
                 shape,
+                turn_rem,
                 _pad
             ]
         ),

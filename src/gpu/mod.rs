@@ -13,6 +13,7 @@
 pub mod device;
 pub mod kernels;
 pub mod layout;
+pub mod orientation;
 pub mod position;
 
 use crate::contacts::{Pair, WALL_BASE};
@@ -203,6 +204,7 @@ impl GpuSimulation {
                 let (radius_units, radius_rem) = position::length_units(one.radius[0], cell_size);
                 let due = source::due_step(source::due_time(spec, st.inserted + k as u32), dt);
                 let shape = [corner_table.len() as u32, one.shape[0].len() as u32];
+                let (turn, turn_rem) = orientation::split_angle(drawn.theta);
                 corner_table.extend_from_slice(&one.shape[0]);
                 candidates.push(Candidate {
                     anchor,
@@ -219,9 +221,10 @@ impl GpuSimulation {
                     flags: ACTIVE | (material << 8),
                     radius_units,
                     radius_rem,
-                    theta: drawn.theta as f32,
+                    turn,
                     shape,
-                    _pad: [0; 2],
+                    turn_rem,
+                    _pad: 0,
                 });
             }
             sources.push(SourceBase {
@@ -386,12 +389,12 @@ impl GpuSimulation {
             candidates: init("candidates", bytemuck::cast_slice(&candidates)),
             corners: init(
                 "corners",
-                bytemuck::cast_slice(
-                    &corner_table
-                        .iter()
-                        .map(|v| [v[0] as f32, v[1] as f32])
-                        .collect::<Vec<[f32; 2]>>(),
-                ),
+                bytemuck::cast_slice(&device_corners(
+                    &corner_table,
+                    &state_all,
+                    &props_all,
+                    position::unit(cell_size),
+                )),
             ),
             tables: [
                 init("springs 0", bytemuck::cast_slice(&table)),
@@ -889,7 +892,34 @@ impl GpuSimulation {
     }
 }
 
-/// Host f64 particles → device layout.
+/// The device's corner buffer: every corner in whole position units, body frame in xy
+/// and rotated to its particle's orientation in zw (as `rotate_corners` in
+/// orientation.wgsl; a candidate's are rotated when it is placed).
+fn device_corners(
+    table: &[[f64; 2]],
+    states: &[State],
+    props: &[Props],
+    unit: f64,
+) -> Vec<[i32; 4]> {
+    let mut out: Vec<[i32; 4]> = table
+        .iter()
+        .map(|&v| {
+            let b = orientation::corner_units(v, unit);
+            [b[0], b[1], b[0], b[1]]
+        })
+        .collect();
+    for (s, p) in states.iter().zip(props) {
+        let sc = orientation::turn_sin_cos(s.turn);
+        let [start, count] = p.shape;
+        for c in &mut out[start as usize..(start + count) as usize] {
+            let w = orientation::rotate_units([c[0], c[1]], sc);
+            c[2] = w[0];
+            c[3] = w[1];
+        }
+    }
+    out
+}
+
 /// Where each particle's corners start in the corner buffer: particles in id order.
 pub fn corner_starts(p: &Particles) -> Vec<u32> {
     p.shape
@@ -902,6 +932,7 @@ pub fn corner_starts(p: &Particles) -> Vec<u32> {
         .collect()
 }
 
+/// Host f64 particles → device layout.
 pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec<Props>) {
     let mut states = Vec::with_capacity(p.len());
     let mut props = Vec::with_capacity(p.len());
@@ -914,7 +945,9 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
             frac,
             ..Default::default()
         };
-        s.q[0] = [rem[0], rem[1], q0[2] as f32, 0.0];
+        let (turn, turn_rem) = orientation::split_angle(q0[2]);
+        s.turn = turn;
+        s.q[0] = [rem[0], rem[1], turn_rem, 0.0];
         for k in 1..GEAR_VALUES {
             let v = p.q[k][i];
             s.q[k] = [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
@@ -954,7 +987,8 @@ pub fn from_device(
             };
             origin[k] + position::join(f, cell)
         };
-        p.q[0].push([coord(0), coord(1), s.q[0][2] as f64]);
+        let theta = orientation::join_angle(s.turn, s.q[0][2]);
+        p.q[0].push([coord(0), coord(1), theta]);
         for k in 1..GEAR_VALUES {
             let v = s.q[k];
             p.q[k].push([v[0] as f64, v[1] as f64, v[2] as f64]);
