@@ -197,6 +197,29 @@ fn find_contacts_matches_the_cpu_for_both_laws() {
 }
 
 /// Relative difference scaled by a typical magnitude.
+/// The CPU's contact forces and updated histories for the given pairs of `host`.
+fn cpu_contact_forces(
+    host: &talus::sim::Simulation,
+    pairs: &[Pair],
+    history: &[f64],
+) -> (Vec<talus::forces::ContactForce>, Vec<f64>) {
+    let (mut cpu, mut hist_out) = (Vec::new(), Vec::new());
+    let mut shapes = WorldShapes::default();
+    world_shapes(&host.particles, &mut shapes);
+    contact_forces(
+        &host.particles,
+        &shapes,
+        &host.walls,
+        &host.law,
+        host.dt(),
+        pairs,
+        history,
+        &mut cpu,
+        &mut hist_out,
+    );
+    (cpu, hist_out)
+}
+
 fn rel(a: f64, b: f64, scale: f64) -> f64 {
     (a - b).abs() / scale
 }
@@ -248,20 +271,7 @@ fn contact_forces_and_reduction_match_the_cpu() {
                 k_global += 1;
             }
         }
-        let (mut cpu, mut hist_out) = (Vec::new(), Vec::new());
-        let mut shapes = WorldShapes::default();
-        world_shapes(&host.particles, &mut shapes);
-        contact_forces(
-            &host.particles,
-            &shapes,
-            &host.walls,
-            &host.law,
-            host.dt(),
-            &pairs,
-            &history,
-            &mut cpu,
-            &mut hist_out,
-        );
+        let (cpu, hist_out) = cpu_contact_forces(&host, &pairs, &history);
         let scale = cpu.iter().map(|c| c.f_n.abs()).fold(0.0, f64::max);
         assert!(scale > 0.0);
         let out = g.read_contact_out(n * MAX_CONTACTS as usize);
@@ -661,20 +671,7 @@ fn polygon_overlaps_are_exact_down_to_1e_6_d() {
     g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces]);
     let host = g.download().clone();
     let n = host.particles.len();
-    let (mut cpu, mut hist_out) = (Vec::new(), Vec::new());
-    let mut shapes = WorldShapes::default();
-    world_shapes(&host.particles, &mut shapes);
-    contact_forces(
-        &host.particles,
-        &shapes,
-        &host.walls,
-        &host.law,
-        host.dt(),
-        &pairs,
-        &vec![0.0; pairs.len()],
-        &mut cpu,
-        &mut hist_out,
-    );
+    let (cpu, _) = cpu_contact_forces(&host, &pairs, &vec![0.0; pairs.len()]);
     let out = g.read_contact_out(n * MAX_CONTACTS as usize);
     let count = g.read_u32("contact_count", n);
     let mut k_global = 0;

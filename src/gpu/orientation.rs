@@ -78,27 +78,22 @@ mod tests {
 
     #[test]
     fn sin_cos_are_right_to_2e_9_all_round() {
+        let error = |turn: u32| {
+            let [s, c] = turn_sin_cos(turn);
+            let (es, ec) = join_angle(turn, 0.0).sin_cos();
+            let q = Q31_ONE as f64;
+            (s as f64 / q - es).abs().max((c as f64 / q - ec).abs())
+        };
         let mut worst: f64 = 0.0;
         let mut turn: u32 = 7;
         for _ in 0..200_000 {
             turn = turn.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            let [s, c] = turn_sin_cos(turn);
-            let (es, ec) = join_angle(turn, 0.0).sin_cos();
-            let q = Q31_ONE as f64;
-            worst = worst
-                .max((s as f64 / q - es).abs())
-                .max((c as f64 / q - ec).abs());
+            worst = worst.max(error(turn));
         }
         // Quarter-turn boundaries and their neighbours.
-        for k in 0..4u32 {
+        for k in 0..4i64 {
             for d in [-1i64, 0, 1, 0x1FFF_FFFF] {
-                let turn = ((k as i64) << 30).wrapping_add(d) as u32;
-                let [s, c] = turn_sin_cos(turn);
-                let (es, ec) = join_angle(turn, 0.0).sin_cos();
-                let q = Q31_ONE as f64;
-                worst = worst
-                    .max((s as f64 / q - es).abs())
-                    .max((c as f64 / q - ec).abs());
+                worst = worst.max(error((k << 30).wrapping_add(d) as u32));
             }
         }
         assert!(worst < 2e-9, "worst error {worst:e}");
