@@ -36,6 +36,11 @@ pub fn row_count(spec: &Layered) -> u32 {
         .count() as u32
 }
 
+/// Number of particles in row k (evenly spaced, at least d_max apart).
+pub fn row_size(spec: &Layered, k: u32) -> usize {
+    (row_width(spec, k) / largest(spec)).floor().max(1.0) as usize
+}
+
 /// Top of the material within `reach` of x (the floor where there is none).
 fn surface(spec: &Layered, particles: &Particles, x: f64, reach: f64) -> f64 {
     (0..particles.len())
@@ -59,7 +64,7 @@ pub fn emit(
     }
     let d = largest(spec);
     let w = row_width(spec, k);
-    let n = (w / d).floor().max(1.0) as usize;
+    let n = row_size(spec, k);
     let spacing = w / n as f64;
     let mut out = Vec::with_capacity(n);
     for m in 0..n {

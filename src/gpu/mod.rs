@@ -17,11 +17,14 @@ pub mod orientation;
 pub mod position;
 
 use crate::contacts::{Pair, WALL_BASE};
-use crate::create::source::{self, SourceState};
+use crate::create::{
+    self,
+    source::{self, SourceState},
+};
 use crate::forces::ContactForce;
 use crate::geometry::{disk_disk, disk_wall};
 use crate::law::ContactLaw;
-use crate::scene::{Creation, IntegratorKind, PointSource};
+use crate::scene::{Creation, IntegratorKind, Layered, PointSource};
 use crate::sim::{Divergence, Simulation};
 use crate::springs::{SpringTable, pair_key};
 use crate::state::{GEAR_VALUES, Particles};
@@ -68,6 +71,14 @@ struct SourceBase {
     state: SourceState,
 }
 
+/// A layer-by-layer block: its rows are laid by the host (`place_layered_rows`), which
+/// reads the pile back to find its surface; its progress is `sim.sources[index]`.
+struct LayeredBase {
+    spec: Layered,
+    material: u32,
+    index: usize,
+}
+
 pub struct GpuSimulation {
     /// The host mirror; its state is current after [`GpuSimulation::download`].
     pub sim: Simulation,
@@ -85,6 +96,7 @@ pub struct GpuSimulation {
     /// The corners in the device's corner buffer, in f64 (shapes of downloaded particles).
     corner_table: Vec<[f64; 2]>,
     sources: Vec<SourceBase>,
+    layered: Vec<LayeredBase>,
     /// Loss count at upload (the GPU counts from there), inactive particles at upload,
     /// and losses on the device after the last submission.
     lost_base: u64,
@@ -126,14 +138,11 @@ impl GpuSimulation {
     }
 
     pub fn with_gpu(mut sim: Simulation, gpu: Gpu) -> Result<Self, GpuError> {
-        if sim
-            .scene
-            .particles
-            .iter()
-            .any(|c| matches!(c, Creation::Layered(_)))
-        {
+        let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);
+        if !point_sources.is_empty() && !layered_specs.is_empty() {
             return Err(GpuError::Unsupported(
-                "layer-by-layer creation is not on the GPU path yet".into(),
+                "point sources together with layer-by-layer blocks are not on the GPU path yet"
+                    .into(),
             ));
         }
         let all_polygons = sim
@@ -232,8 +241,27 @@ impl GpuSimulation {
                 state: st.clone(),
             });
         }
+        // Layered rows still to come: their sizes are fixed by the outline, so the
+        // buffers are sized for them now (their corners go after the candidates').
+        let mut layered = Vec::new();
+        let mut layered_count = 0u32;
+        let mut layered_corners = 0usize;
+        for (m, spec) in layered_specs.iter().enumerate() {
+            let index = specs.len() + m;
+            let corners = spec.polygon.as_ref().map_or(0, |p| p.corners as usize);
+            for k in sim.sources[index].inserted..create::layered::row_count(spec) {
+                let n = create::layered::row_size(spec, k);
+                layered_count += n as u32;
+                layered_corners += n * corners;
+            }
+            layered.push(LayeredBase {
+                spec: spec.clone(),
+                material: crate::create::material_index(&sim.scene, &spec.material),
+                index,
+            });
+        }
         let n_now = sim.particles.len() as u32;
-        let n_cap = (n_now + candidates.len() as u32).max(1);
+        let n_cap = (n_now + candidates.len() as u32 + layered_count).max(1);
         let table_cap = (8 * n_cap as u64).next_power_of_two().max(64);
 
         let law = &sim.law;
@@ -389,12 +417,16 @@ impl GpuSimulation {
             candidates: init("candidates", bytemuck::cast_slice(&candidates)),
             corners: init(
                 "corners",
-                bytemuck::cast_slice(&device_corners(
-                    &corner_table,
-                    &state_all,
-                    &props_all,
-                    position::unit(cell_size),
-                )),
+                bytemuck::cast_slice(&{
+                    let mut c = device_corners(
+                        &corner_table,
+                        &state_all,
+                        &props_all,
+                        position::unit(cell_size),
+                    );
+                    c.resize(c.len() + layered_corners, [0; 4]);
+                    c
+                }),
             ),
             tables: [
                 init("springs 0", bytemuck::cast_slice(&table)),
@@ -472,6 +504,7 @@ impl GpuSimulation {
             origin,
             corner_table,
             sources,
+            layered,
             lost_base,
             inactive_at_upload,
             lost_now: 0,
@@ -601,7 +634,15 @@ impl GpuSimulation {
         let mut left = steps;
         let sources_left = self.sources_left();
         while left > 0 {
-            let k = left.min(STEPS_PER_SUBMIT);
+            let mut k = left.min(STEPS_PER_SUBMIT);
+            // Submissions stop where a layered row is due; the host lays it.
+            if let Some(due) = self.next_layered_step() {
+                if due == self.step {
+                    self.place_layered_rows();
+                } else {
+                    k = k.min(due - self.step);
+                }
+            }
             let mut enc = self.gpu.device.create_command_encoder(&Default::default());
             {
                 let mut pass = enc.begin_compute_pass(&Default::default());
@@ -624,6 +665,87 @@ impl GpuSimulation {
             left -= k;
         }
         Ok(())
+    }
+
+    /// The first step, from now on, at which a layered block lays its next row (as the
+    /// CPU path decides it: at the start of the first step with t ≥ its time).
+    fn next_layered_step(&self) -> Option<u64> {
+        let dt = self.sim.scene.dt;
+        self.layered
+            .iter()
+            .filter_map(|b| {
+                let k = self.sim.sources[b.index].inserted;
+                if k >= create::layered::row_count(&b.spec) {
+                    return None;
+                }
+                let due = b.spec.start_time + k as f64 * b.spec.interval;
+                let mut s = ((due / dt).floor() as u64).saturating_sub(1).max(self.step);
+                while (s as f64) * dt < due {
+                    s += 1;
+                }
+                Some(s)
+            })
+            .min()
+    }
+
+    /// Lays the rows due at this step (`create::layered::emit` on the read-back pile) and
+    /// appends them to the device, in the CPU path's order.
+    fn place_layered_rows(&mut self) {
+        let t = self.step as f64 * self.sim.scene.dt;
+        self.download();
+        let cell = self.params.cell_size;
+        let unit = position::unit(cell);
+        let gear = self.sim.scene.integrator == IntegratorKind::Gear5;
+        let h = 0.5 * self.sim.scene.dt * self.sim.scene.dt;
+        let g = self.sim.gravity(t);
+        let mut live = self.live as usize;
+        for b in &self.layered {
+            let new = create::layered::emit(
+                &b.spec,
+                &mut self.sim.sources[b.index],
+                t,
+                b.material,
+                &self.sim.particles,
+            );
+            for np in &new {
+                let mut one = Particles::default();
+                create::push(&self.sim.scene, &mut one, np);
+                if gear {
+                    one.q[2][0] = [h * g[0], h * g[1], 0.0];
+                }
+                let (st, mut pr) = to_device(&one, self.origin, cell);
+                let first = self.corner_table.len();
+                pr[0].shape[0] = first as u32;
+                let corners = device_corners(&one.shape[0], &st, &pr_local(&pr[0]), unit);
+                self.corner_table.extend_from_slice(&one.shape[0]);
+                let q = &self.gpu.queue;
+                q.write_buffer(
+                    &self.buffers.state,
+                    (live * size_of::<State>()) as u64,
+                    bytemuck::cast_slice(&st[..]),
+                );
+                q.write_buffer(
+                    &self.buffers.props,
+                    (live * size_of::<Props>()) as u64,
+                    bytemuck::cast_slice(&pr[..]),
+                );
+                if !corners.is_empty() {
+                    q.write_buffer(
+                        &self.buffers.corners,
+                        (first * 16) as u64,
+                        bytemuck::cast_slice(&corners),
+                    );
+                }
+                live += 1;
+            }
+        }
+        self.live = live as u32;
+        self.gpu.queue.write_buffer(
+            &self.buffers.control,
+            (control::LIVE * 4) as u64,
+            bytemuck::bytes_of(&self.live),
+        );
+        self.synced = false;
     }
 
     fn halt_cause(&mut self, c: &[u32]) -> Divergence {
@@ -749,12 +871,10 @@ impl GpuSimulation {
         }
         self.sim.springs = table;
         let rows: Vec<Source> = self.read_buffer(&self.buffers.sources, 0, self.sources.len());
-        self.sim.sources = self
-            .sources
-            .iter()
-            .zip(&rows)
-            .map(|(b, r)| source::advanced(&b.spec, &b.state, r.inserted))
-            .collect();
+        // Point sources advance on the device; layered blocks (after them) on the host.
+        for (k, (b, r)) in self.sources.iter().zip(&rows).enumerate() {
+            self.sim.sources[k] = source::advanced(&b.spec, &b.state, r.inserted);
+        }
         // This step's contacts, in the CPU's order (by i, then j; walls last).
         let m = MAX_CONTACTS as usize;
         let count: Vec<u32> = self.read_buffer(&self.buffers.contact_count, 0, live);
@@ -918,6 +1038,15 @@ fn device_corners(
         }
     }
     out
+}
+
+/// One particle's props with its corners counted from 0 (for `device_corners` on a
+/// table of its own corners).
+fn pr_local(p: &Props) -> [Props; 1] {
+    [Props {
+        shape: [0, p.shape[1]],
+        ..*p
+    }]
 }
 
 /// Where each particle's corners start in the corner buffer: particles in id order.
