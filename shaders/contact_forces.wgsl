@@ -36,7 +36,7 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         var rate = 1.0;
         if (POLYGONS) {
             var a: AreaContact;
-            if (wall) { a = polygon_wall_iw(i, j - WALL_BASE, false); } else { a = polygons_ij(i, j, false); }
+            if (wall) { a = area_contact_wall(i, j - WALL_BASE, false); } else { a = area_contact(i, j, false); }
             var delta = 0.0;
             var depth = 0.0;
             rate = 0.0;

@@ -14,7 +14,7 @@ fn in_range(i: u32, j: u32) -> bool {
     let margin = 2.0e-5 * reach * reach;
     if (r2 > reach * reach + margin) { return false; }
     // Polygons: inside the circumscribed circles, a contact is a positive overlap area.
-    if (POLYGONS) { return polygons_ij(i, j, true).found; }
+    if (POLYGONS) { return area_contact(i, j, true).found; }
     if (r2 < reach * reach - margin) { return true; }
     let g = disk_disk(i, j);
     return g.r < params.range_factor * g.sigma;
@@ -25,7 +25,7 @@ fn touches_wall(i: u32, w: u32) -> bool {
     if (POLYGONS) {
         // The circumscribed circle first (with f32 slack), then the area.
         if (g.delta < -1.0e-5 * props[i].radius) { return false; }
-        return polygon_wall_iw(i, w, true).found;
+        return area_contact_wall(i, w, true).found;
     }
     return g.r < params.range_factor * g.sigma;
 }

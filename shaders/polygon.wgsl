@@ -530,3 +530,308 @@ fn polygon_wall_iw(i: u32, w: u32, only_area: bool) -> AreaContact {
     g.point *= u;
     return g;
 }
+
+// ---- Disks under the overlap-area law (mixed scenes; src/overlap.rs) ----
+//
+// The CPU path computes these areas in f64 by general formulas (triangles in a circle,
+// lens, segment). In f32 those cancel badly for a small overlap, so here each area is
+// built from an overlap depth that is exact in position units: a circular segment of
+// known sagitta, a lens of two segments, a triangle at a corner plus a segment. Only a
+// polygon-disk overlap that is none of these (a deep one) falls back to the general
+// formula in f32.
+
+// x - sin x, by its series where it cancels.
+fn x_minus_sin(x: f32) -> f32 {
+    if (x > 1.0) { return x - sin(x); }
+    let x2 = x * x;
+    return x * x2 * (1.0 / 6.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 5040.0 - x2 * (1.0 / 362880.0 - x2 / 39916800.0))));
+}
+
+// Area of the circular segment of radius r beyond a chord at depth e (the sagitta):
+// r^2/2 (x - sin x) with x the central angle, x = 4 asin(sqrt(e / 2r)); asin by its
+// series for small arguments (relative error below 1e-9 up to 0.25).
+fn segment_area(r: f32, e: f32) -> f32 {
+    let y = sqrt(clamp(e / (2.0 * r), 0.0, 1.0));
+    var a = 0.0;
+    if (y > 0.25) {
+        a = asin(y);
+    } else {
+        let y2 = y * y;
+        a = y * (1.0 + y2 * (1.0 / 6.0 + y2 * (3.0 / 40.0 + y2 * (5.0 / 112.0 + y2 * (35.0 / 1152.0 + y2 * (63.0 / 2816.0))))));
+    }
+    return 0.5 * r * r * x_minus_sin(4.0 * a);
+}
+
+// The lens of two disks (src/overlap.rs `disk_disk_area`), in length units with the
+// force point relative to centre i. The overlap delta is exact (geometry.wgsl); the
+// sagittas of the two segments are delta (r_j + d - r_i) / 2d and delta (r_i + d - r_j) / 2d.
+fn disks_area_ij(i: u32, j: u32) -> AreaContact {
+    let g = disk_disk(i, j);
+    if (!g.near || g.delta <= 0.0) { return no_contact(); }
+    let ri = props[i].radius;
+    let rj = props[j].radius;
+    let d = g.r;
+    var c = no_contact();
+    c.found = true;
+    c.n = g.n;
+    if (d <= abs(ri - rj)) {
+        // One inside the other: the smaller disk's area, at its centre.
+        let small = min(ri, rj);
+        c.area = 3.14159265 * small * small;
+        if (ri >= rj) { c.point = -g.n * d; }
+        c.l = reduced_arm(length(c.point), length(c.point + g.n * d), ri + rj);
+        return c;
+    }
+    let ei = g.delta * (rj + d - ri) / (2.0 * d);
+    let ej = g.delta * (ri + d - rj) / (2.0 * d);
+    c.area = segment_area(ri, ei) + segment_area(rj, ej);
+    c.chord = 2.0 * sqrt(max(ej * (2.0 * rj - ej), 0.0));
+    c.point = -g.n * (ri - ei);
+    c.l = reduced_arm(ri - ei, rj - ej, ri + rj);
+    return c;
+}
+
+// A disk and a wall (src/overlap.rs `disk_wall_area`): the segment beyond the wall's
+// line, of the exact depth of geometry.wgsl's `disk_wall`, scaled by the part of its
+// chord that lies over the wall (an approximation at the wall's ends, as on the CPU).
+fn disk_wall_area(i: u32, w: u32) -> AreaContact {
+    let s = state[i];
+    let wall = walls[w];
+    let r = props[i].radius;
+    let oa = offset(s.anchor, s.frac, s.q[0].xy, wall.a_anchor, wall.a_frac, wall.a_rem);
+    let p = offset_vector(oa);   // centre - a
+    let len = length(wall.ab);
+    if (len == 0.0) { return no_contact(); }
+    let tt = wall.ab / len;
+    var m = vec2<f32>(-tt.y, tt.x);
+    var dist = dot(p, m);
+    if (dist < 0.0) { m = -m; dist = -dist; }
+    var delta = r - dist;
+    let k = select(0u, 1u, wall.ab.y == 0.0);
+    if ((wall.ab.x == 0.0 || wall.ab.y == 0.0) && abs(oa.da[k]) <= 1) {
+        // The coordinate along the normal is exact in units (as in `disk_wall`).
+        let sgn = select(-1.0, 1.0, f32(oa.d[k]) + oa.e[k] >= 0.0);
+        let whole = i32(sgn) * oa.d[k];
+        delta = (f32(i32(props[i].radius_units) - whole) + (props[i].radius_rem - sgn * oa.e[k])) * params.unit;
+        dist = r - delta;
+    }
+    if (delta <= 0.0) { return no_contact(); }
+    let h = sqrt(delta * (2.0 * r - delta));
+    let along = dot(p, tt);
+    let lo = max(along - h, 0.0);
+    let hi = min(along + h, len);
+    if (hi <= lo) { return no_contact(); }
+    var c = no_contact();
+    c.found = true;
+    c.area = segment_area(r, delta) * (hi - lo) / (2.0 * h);
+    c.n = m;
+    c.chord = hi - lo;
+    c.point = -dist * m + (0.5 * (lo + hi) - along) * tt;
+    c.l = max(length(c.point), 1.0e-9 * r);
+    return c;
+}
+
+// Signed area of the triangle (0, a, b) inside the circle of radius r about the origin
+// (src/overlap.rs `triangle_in_circle`): the fallback for deep polygon-disk overlaps.
+fn triangle_in_circle(a: vec2<f32>, b: vec2<f32>, r: f32) -> f32 {
+    let d = b - a;
+    let qa = dot(d, d);
+    let qb = 2.0 * dot(a, d);
+    let qc = dot(a, a) - r * r;
+    var ts = array<f32, 4>(0.0, 1.0, 1.0, 1.0);
+    var n = 1u;
+    let disc = qb * qb - 4.0 * qa * qc;
+    if (qa > 0.0 && disc > 0.0) {
+        let s = sqrt(disc);
+        let t1 = (-qb - s) / (2.0 * qa);
+        let t2 = (-qb + s) / (2.0 * qa);
+        if (t1 > 0.0 && t1 < 1.0) { ts[n] = t1; n++; }
+        if (t2 > 0.0 && t2 < 1.0) { ts[n] = t2; n++; }
+    }
+    ts[n] = 1.0;
+    var sum = 0.0;
+    for (var k = 0u; k < n; k++) {
+        let p = a + ts[k] * d;
+        let q = a + ts[k + 1u] * d;
+        let m = a + 0.5 * (ts[k] + ts[k + 1u]) * d;
+        let c = p.x * q.y - p.y * q.x;
+        if (dot(m, m) <= r * r) { sum += 0.5 * c; } else { sum += 0.5 * r * r * atan2(c, dot(p, q)); }
+    }
+    return sum;
+}
+
+// Overlap depth (units) of point w + e inside the circle of radius r_units + r_rem
+// about the origin: exact, as a disk-point pair (geometry.wgsl).
+fn depth_in_circle(w: vec2<i32>, e: vec2<f32>, r_units: u32, r_rem: f32) -> f32 {
+    let dist = distance_units(w, e);
+    var whole = f32(r_units) - f32(dist.whole);
+    if (dist.whole < 0x80000000u) { whole = f32(i32(r_units) - i32(dist.whole)); }
+    return whole + (r_rem - dist.corr);
+}
+
+// Area contact of polygon `poly` and disk `disk` (polygon_is_i: which one is i), in
+// length units with the force point relative to centre i. Frame: the disk's centre.
+fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
+    let o = offset_ij(poly, disk);
+    if (!o.near || any(abs(o.d) > vec2<i32>(1610612736))) { return no_contact(); }
+    var p: Outline;
+    load_outline(poly, o.d, o.e, &p);
+    let ru = props[disk].radius_units;
+    let rr = props[disk].radius_rem;
+    let r = f32(ru) + rr;                       // units
+    let cp = vec2<f32>(o.d) + o.e;             // polygon centre
+    let np = p.n;
+    var inside = 0u;
+    var mask = 0u;
+    var corner = 0u;
+    var depth = 0.0;
+    for (var m = 0u; m < np; m++) {
+        let dm = depth_in_circle(p.w[m], corner_e(&p, m), ru, rr);
+        if (dm > 0.0) { inside++; mask |= 1u << m; corner = m; depth = dm; }
+    }
+    // Edges with both ends outside that the circle cuts twice (`cut` of them with the
+    // disk's centre on their outer side), and whether the centre is inside the polygon.
+    // With no corner inside, no edge cut and the centre outside there is no overlap.
+    var cut = 0u;
+    var cut_any = 0u;
+    var edge = 0u;
+    var centre_inside = true;
+    for (var m = 0u; m < np; m++) {
+        let m2 = (m + 1u) % np;
+        let a = corner_at(&p, m, vec2<i32>(0));
+        let ab = corner_at(&p, m2, vec2<i32>(0)) - a;
+        let outside = cross2(ab, -a) < 0.0;
+        if (outside) { centre_inside = false; }
+        let t = -dot(a, ab) / dot(ab, ab);
+        let f = a + t * ab;
+        let ends_out = (mask & ((1u << m) | (1u << m2))) == 0u;
+        if (ends_out && t > 0.0 && t < 1.0 && dot(f, f) < r * r) {
+            cut_any++;
+            if (outside) { cut++; edge = m; }
+        }
+    }
+    if (inside == 0u && cut == 0u && !centre_inside) { return no_contact(); }
+    var g = no_contact();
+    var towards_disk = vec2<f32>(0.0);
+    if (inside == 0u && cut == 1u && cut_any == 1u) {
+        // A sliver under one face: a segment whose depth is exact from an integer dot
+        // product with the face's normal in Q30.
+        let a = edge;
+        let b = (edge + 1u) % np;
+        let ab = vec2<f32>(p.w[b] - p.w[a]);
+        let t = ab / length(ab);
+        let nout = vec2<f32>(t.y, -t.x);         // out of the polygon, towards the disk
+        let nq = vec2<i32>(round(nout * Q30));
+        let exact = add64(add64(smul(p.w[a].x, nq.x), smul(p.w[a].y, nq.y)),
+                          vec2<u32>(ru << 30u, ru >> 2u));
+        let delta = i64_to_f32(exact) / Q30 + rr + dot(corner_e(&p, a), nout);
+        if (delta <= 0.0) { return no_contact(); }
+        g.area = segment_area(r, delta);
+        g.chord = 2.0 * sqrt(max(delta * (2.0 * r - delta), 0.0));
+        g.point = -(r - delta) * nout;
+        towards_disk = nout;
+    } else if (inside == 1u && cut_any == 0u) {
+        // One corner inside: the triangle it cuts off with the circle plus the segment
+        // beyond the chord, from its exact depth.
+        let v = corner_at(&p, corner, vec2<i32>(0));
+        let u1 = normalize(corner_at(&p, (corner + np - 1u) % np, vec2<i32>(0)) - v);
+        let u2 = normalize(corner_at(&p, (corner + 1u) % np, vec2<i32>(0)) - v);
+        let k = depth * (2.0 * r - depth);     // r^2 - |v|^2
+        let b1 = dot(v, u1);
+        let b2 = dot(v, u2);
+        var s1 = -b1 + sqrt(b1 * b1 + k);
+        if (b1 > 0.0) { s1 = k / (b1 + sqrt(b1 * b1 + k)); }
+        var s2 = -b2 + sqrt(b2 * b2 + k);
+        if (b2 > 0.0) { s2 = k / (b2 + sqrt(b2 * b2 + k)); }
+        let x1 = v + s1 * u1;
+        let x2 = v + s2 * u2;
+        let chord = sqrt(max(s1 * s1 + s2 * s2 - 2.0 * s1 * s2 * dot(u1, u2), 0.0));
+        let half = 0.5 * chord;
+        let sag = half * half / (r + sqrt(max(r * r - half * half, 0.0)));
+        g.area = 0.5 * s1 * s2 * abs(cross2(u1, u2)) + segment_area(r, sag);
+        g.chord = chord;
+        g.point = 0.5 * (x1 + x2);
+        let tt = (x2 - x1) / max(chord, 1.0e-30);
+        let nn = vec2<f32>(-tt.y, tt.x);
+        towards_disk = nn * select(-1.0, 1.0, dot(nn, -g.point) + dot(nn, v - g.point) > 0.0);
+    } else {
+        // Deep or unusual: the general formula in f32 (src/overlap.rs `polygon_disk`),
+        // the force point between the two crossings of the outlines farthest apart.
+        var area = 0.0;
+        var xs: array<vec2<f32>, 32>;
+        var nx = 0u;
+        for (var m = 0u; m < np; m++) {
+            let a = corner_at(&p, m, vec2<i32>(0));
+            let b = corner_at(&p, (m + 1u) % np, vec2<i32>(0));
+            area += triangle_in_circle(a, b, r);
+            let d = b - a;
+            let qa = dot(d, d);
+            let qb = 2.0 * dot(a, d);
+            let disc = qb * qb - 4.0 * qa * (dot(a, a) - r * r);
+            if (qa > 0.0 && disc >= 0.0) {
+                let sq = sqrt(disc);
+                for (var k = 0u; k < 2u; k++) {
+                    let t = (-qb + select(-sq, sq, k == 1u)) / (2.0 * qa);
+                    if (t >= 0.0 && t < 1.0 && nx < 32u) { xs[nx] = a + t * d; nx++; }
+                }
+            }
+        }
+        if (area <= 0.0) { return no_contact(); }
+        g.area = area;
+        towards_disk = -cp / max(length(cp), 1.0e-30);
+        if (length(cp) == 0.0) { towards_disk = vec2<f32>(0.0, -1.0); }
+        var best = -1.0;
+        for (var a = 0u; a < nx; a++) {
+            for (var b = a + 1u; b < nx; b++) {
+                let d = length(xs[b] - xs[a]);
+                if (d > best) {
+                    best = d;
+                    g.point = 0.5 * (xs[a] + xs[b]);
+                    g.chord = d;
+                    let tt = (xs[b] - xs[a]) / max(d, 1.0e-30);
+                    towards_disk = vec2<f32>(-tt.y, tt.x);
+                }
+            }
+        }
+        if (best > 1.0e-6 * r) {
+            // The disk's side: its centre and the polygon's corners inside it.
+            var side = dot(towards_disk, -g.point);
+            for (var m = 0u; m < np; m++) {
+                if ((mask & (1u << m)) != 0u) { side += dot(towards_disk, corner_at(&p, m, vec2<i32>(0)) - g.point); }
+            }
+            if (side < 0.0) { towards_disk = -towards_disk; }
+        } else {
+            g.point = vec2<f32>(0.0);
+            g.chord = 0.0;
+            towards_disk = -cp / max(length(cp), 1.0e-30);
+            if (length(cp) == 0.0) { towards_disk = vec2<f32>(0.0, -1.0); }
+        }
+    }
+    g.found = true;
+    g.n = select(towards_disk, -towards_disk, polygon_is_i);
+    let scale = length(cp) + 2.0 * r;
+    g.l = reduced_arm(length(g.point - cp), length(g.point), scale);
+    let u = params.unit;
+    g.area *= u * u;
+    g.chord *= u;
+    g.l *= u;
+    if (polygon_is_i) { g.point -= cp; }
+    g.point *= u;
+    return g;
+}
+
+// The area contact of particles i and j, whatever their shapes (force point relative
+// to centre i).
+fn area_contact(i: u32, j: u32, only_area: bool) -> AreaContact {
+    let pi = props[i].shape.y > 0u;
+    let pj = props[j].shape.y > 0u;
+    if (pi && pj) { return polygons_ij(i, j, only_area); }
+    if (pi) { return polygon_disk_ij(i, j, true); }
+    if (pj) { return polygon_disk_ij(j, i, false); }
+    return disks_area_ij(i, j);
+}
+
+fn area_contact_wall(i: u32, w: u32, only_area: bool) -> AreaContact {
+    if (props[i].shape.y > 0u) { return polygon_wall_iw(i, w, only_area); }
+    return disk_wall_area(i, w);
+}

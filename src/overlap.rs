@@ -11,7 +11,7 @@
 //! edges) take the two that are farthest apart, which spans the thin overlap along its
 //! length.
 
-use crate::geometry::WallSegment;
+use crate::geometry::{WallSegment, cross};
 use crate::shape::{MAX_CORNERS, P2};
 
 /// Most corners an overlap polygon can have: each clipping half-plane adds at most one.
@@ -509,6 +509,22 @@ fn circle_crossings(p: &[P2], c: P2, r: f64, out: &mut Poly) {
 /// disk's centre lie on the disk's side of that line.
 pub fn polygon_disk(p: &[P2], cp: P2, c: P2, r: f64, polygon_is_i: bool) -> Option<AreaContact> {
     let n = p.len();
+    // No corner inside the circle, no edge cut by it and the centre outside the polygon:
+    // no overlap (the sum below would give round-off instead of zero). As in the kernel.
+    let inside = |v: P2| dot(sub(v, c), sub(v, c)) < r * r;
+    let (mut cut, mut centre_inside) = (false, true);
+    for k in 0..n {
+        let (a, ab) = (p[k], sub(p[(k + 1) % n], p[k]));
+        if cross(ab, sub(c, a)) < 0.0 {
+            centre_inside = false;
+        }
+        let t = dot(sub(c, a), ab) / dot(ab, ab);
+        let f = [a[0] + t * ab[0], a[1] + t * ab[1]];
+        cut |= t > 0.0 && t < 1.0 && inside(f);
+    }
+    if !cut && !centre_inside && !p.iter().any(|&v| inside(v)) {
+        return None;
+    }
     let area: f64 = (0..n)
         .map(|k| triangle_in_circle(sub(p[k], c), sub(p[(k + 1) % n], c), r))
         .sum();

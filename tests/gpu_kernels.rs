@@ -50,6 +50,21 @@ fn random_scene(n: usize, law: serde_json::Value, seed: u64) -> serde_json::Valu
     v
 }
 
+/// `random_scene` of heptagons with every third particle a disk instead.
+fn mixed_scene(n: usize, seed: u64) -> serde_json::Value {
+    let mut v = random_scene(n, polygons(), seed);
+    let all = v["particles"][0]["particles"].as_array().unwrap().clone();
+    let (disks, polys): (Vec<_>, Vec<_>) =
+        all.into_iter().enumerate().partition(|(k, _)| k % 3 == 0);
+    let strip =
+        |l: Vec<(usize, serde_json::Value)>| l.into_iter().map(|(_, p)| p).collect::<Vec<_>>();
+    v["particles"] = json!([
+        { "kind": "list", "material": "m", "particles": strip(polys), "polygon": { "corners": 7 } },
+        { "kind": "list", "material": "m", "particles": strip(disks) }
+    ]);
+    v
+}
+
 fn spring_dashpot() -> serde_json::Value {
     json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 5.0, "k_t": 500.0, "gamma_t": 1.0, "mu": 0.5 })
 }
@@ -164,8 +179,14 @@ fn find_contacts_matches_the_cpu_for_both_laws() {
         ("spring_dashpot", spring_dashpot()),
         ("continuous", continuous()),
         ("polygons", polygons()),
+        ("mixed", json!("mixed")),
     ] {
-        let Some(mut g) = setup("find_contacts_matches_the_cpu", &random_scene(600, law, 3)) else {
+        let scene = if law == "mixed" {
+            mixed_scene(600, 3)
+        } else {
+            random_scene(600, law, 3)
+        };
+        let Some(mut g) = setup("find_contacts_matches_the_cpu", &scene) else {
             return;
         };
         let pairs = gpu_pairs(&mut g);
@@ -186,7 +207,11 @@ fn find_contacts_matches_the_cpu_for_both_laws() {
             &mut cpu,
         );
         // Heptagons inscribed in the disks' circles touch less often.
-        let dense = if name == "polygons" { 300 } else { 500 };
+        let dense = if name == "polygons" || name == "mixed" {
+            300
+        } else {
+            500
+        };
         assert!(
             cpu.len() > dense,
             "{name}: a dense packing ({} contacts)",
@@ -196,7 +221,6 @@ fn find_contacts_matches_the_cpu_for_both_laws() {
     }
 }
 
-/// Relative difference scaled by a typical magnitude.
 /// The CPU's contact forces and updated histories for the given pairs of `host`.
 fn cpu_contact_forces(
     host: &talus::sim::Simulation,
@@ -233,8 +257,14 @@ fn contact_forces_and_reduction_match_the_cpu() {
         ("spring_dashpot", spring_dashpot()),
         ("continuous", continuous()),
         ("polygons", polygons()),
+        ("mixed", json!("mixed")),
     ] {
-        let Some(mut g) = setup("contact_forces_match_the_cpu", &random_scene(400, law, 4)) else {
+        let scene = if law == "mixed" {
+            mixed_scene(400, 4)
+        } else {
+            random_scene(400, law, 4)
+        };
+        let Some(mut g) = setup("contact_forces_match_the_cpu", &scene) else {
             return;
         };
         let pairs = gpu_pairs(&mut g);
@@ -706,4 +736,153 @@ fn polygon_overlaps_are_exact_down_to_1e_6_d() {
         worst_face < 5e-9 && worst_random < 5e-9,
         "A/l off by more than 1e-3 relative + 5e-9 d: {worst_face:.2e}, {worst_random:.2e}"
     );
+}
+
+/// Touching pairs with disks under the overlap-area law: a regular 12-gon and a disk
+/// along a face normal, an irregular heptagon and a disk from a random direction (corner
+/// first, mostly), two disks; each pushed together by a random gap. And disks resting on
+/// the floor by a random overlap. Pairs are (2k, 2k + 1); the floor disks come last.
+fn touching_mixed(pairs: usize, seed: u64) -> talus::sim::Simulation {
+    use talus::overlap::polygon_disk;
+    use talus::shape::world;
+    let mut rng = Rng::new(seed);
+    let mut blocks = Vec::new();
+    let kinds = [(Some(12), 1.0), (Some(7), 1.1), (None, 1.0)];
+    for k in 0..3 * pairs {
+        let (corners, d) = kinds[k % 3];
+        let x = 5.0 * k as f64;
+        let mut first = json!({ "kind": "list", "material": "m",
+            "particles": [{ "position": [x, 2.0], "diameter": d }] });
+        if let Some(c) = corners {
+            first["polygon"] = json!({ "corners": c, "irregular": c == 7 });
+        }
+        blocks.push(first);
+        let dj = rng.range(0.7, 1.3);
+        blocks.push(json!({ "kind": "list", "material": "m",
+            "particles": [{ "position": [x, 4.0], "diameter": dj }] }));
+    }
+    for k in 0..pairs {
+        blocks.push(json!({ "kind": "list", "material": "m",
+            "particles": [{ "position": [5.0 * k as f64, 7.0], "diameter": rng.range(0.7, 1.3) }] }));
+    }
+    let mut v = common::scene_value(polygons(), json!(blocks));
+    v["contact"]["k_n"] = json!(1.0e7);
+    v["dt"] = json!(1e-5);
+    let w = 15.0 * pairs as f64 + 5.0;
+    v["domain"] = json!({ "x": [-3.0, w], "z": [-2.0, 10.0] });
+    v["walls"] = json!([{ "from": [-3.0, 6.0], "to": [w, 6.0] }]);
+    let mut sim = common::sim(&v);
+    let p = &mut sim.particles;
+    let mut a = Vec::new();
+    for k in 0..3 * pairs {
+        let (i, j) = (2 * k, 2 * k + 1);
+        let ti = rng.range(-3.2, 3.2);
+        let rj = p.radius[j];
+        let ci = p.q[0][i];
+        let u = match k % 3 {
+            0 => {
+                world(&p.shape[i], [0.0, 0.0], ti, &mut a);
+                let e = [a[1][0] - a[0][0], a[1][1] - a[0][1]];
+                let l = e[0].hypot(e[1]);
+                [e[1] / l, -e[0] / l]
+            }
+            _ => {
+                let t = rng.range(0.0, std::f64::consts::TAU);
+                [t.cos(), t.sin()]
+            }
+        };
+        let touch = |s: f64, a: &mut Vec<[f64; 2]>| match k % 3 {
+            2 => s < p.radius[i] + rj,
+            _ => {
+                world(&p.shape[i], [0.0, 0.0], ti, a);
+                polygon_disk(a, [0.0, 0.0], [s * u[0], s * u[1]], rj, true).is_some()
+            }
+        };
+        let (mut lo, mut hi) = (0.0, 3.0);
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if touch(mid, &mut a) {
+                lo = mid
+            } else {
+                hi = mid
+            }
+        }
+        // A face or a disk: A/l grows as the gap; a corner into a disk as its square.
+        let gap = if k % 3 == 1 {
+            10f64.powf(rng.range(-3.0, -1.5))
+        } else {
+            10f64.powf(rng.range(-6.0, -3.0))
+        };
+        let s = lo - gap;
+        p.q[0][i] = [ci[0], ci[1], ti];
+        p.q[0][j] = [ci[0] + s * u[0], ci[1] + s * u[1], 0.0];
+    }
+    for k in 0..pairs {
+        let f = 6 * pairs + k;
+        let gap = 10f64.powf(rng.range(-6.0, -3.0));
+        p.q[0][f][1] = 6.0 + p.radius[f] - gap;
+    }
+    sim
+}
+
+#[test]
+fn disk_overlaps_under_the_area_law_are_exact_down_to_1e_6_d() {
+    // Mixed scenes (SPEC 2.3): polygon-disk, disk-disk and disk-wall area contacts at
+    // k^n = 1e7 and A/l from ~1e-6 d: the GPU's exact-depth forms (polygon.wgsl, "Disks
+    // under the overlap-area law") against the f64 CPU path.
+    let sim = touching_mixed(12, 5);
+    let Some(gpu) = common::gpu("disk_overlaps_under_the_area_law") else {
+        return;
+    };
+    let mut g = GpuSimulation::with_gpu(sim, gpu).expect("uploads");
+    let pairs = gpu_pairs(&mut g);
+    g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces]);
+    let host = g.download().clone();
+    let n = host.particles.len();
+    let (cpu, _) = cpu_contact_forces(&host, &pairs, &vec![0.0; pairs.len()]);
+    let out = g.read_contact_out(n * MAX_CONTACTS as usize);
+    let count = g.read_u32("contact_count", n);
+    let names = [
+        "polygon face-disk",
+        "polygon corner-disk",
+        "disk-disk",
+        "disk-wall",
+    ];
+    let mut worst = [0.0f64; 4];
+    let mut seen = [0usize; 4];
+    let mut k_global = 0;
+    for i in 0..n {
+        for k in 0..count[i] as usize {
+            let o = out[i * MAX_CONTACTS as usize + k];
+            let c = &cpu[k_global];
+            let kind = if pairs[k_global].is_wall() {
+                3
+            } else {
+                (i / 2) % 3
+            };
+            let e = (o.info[2] as f64 - c.overlap).abs() - 1e-3 * c.overlap;
+            worst[kind] = worst[kind].max(e);
+            seen[kind] += 1;
+            k_global += 1;
+        }
+    }
+    for k in 0..4 {
+        eprintln!(
+            "{}: {} contacts, A/l beyond 1e-3 relative {:.2e} d",
+            names[k], seen[k], worst[k]
+        );
+    }
+    assert_eq!(
+        seen,
+        [12, 12, 12, 12],
+        "every pair touches, and only its own partner"
+    );
+    for k in 0..4 {
+        assert!(
+            worst[k] < 5e-9,
+            "{}: A/l off by {:.2e} d beyond 1e-3",
+            names[k],
+            worst[k]
+        );
+    }
 }

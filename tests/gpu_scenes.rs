@@ -470,6 +470,59 @@ fn polygon_pour_agrees_with_the_cpu_then_statistically() {
     );
 }
 
+/// The heptagon pour with a second source pouring disks beside it (SPEC 2.3 mixed
+/// shapes: polygon-disk, disk-disk and disk-wall area contacts).
+fn mixed_pour() -> talus::scene::Scene {
+    let mut v = serde_json::to_value(polygon_pour()).unwrap();
+    let mut disks = v["particles"][0].clone();
+    disks.as_object_mut().unwrap().remove("polygon");
+    disks["position"] = json!([2.0, 8.0]);
+    disks["diameter"] = json!({ "uniform": [0.8, 1.2] });
+    disks["count"] = json!(25);
+    v["particles"].as_array_mut().unwrap().push(disks);
+    common::parse(&v)
+}
+
+#[test]
+fn mixed_pour_agrees_with_the_cpu_then_statistically() {
+    let Some(mut g) = gpu_sim("mixed_pour_agrees_with_the_cpu", mixed_pour()) else {
+        return;
+    };
+    let mut cpu = Simulation::new(mixed_pour()).unwrap();
+    // Free fall and the first impacts on the floor (from t = 1.4): f32 against f64.
+    let early = 800;
+    g.advance(early).unwrap();
+    (0..early).for_each(|_| cpu.step().unwrap());
+    let d = max_position_difference(g.download(), &cpu, 1.0);
+    assert_eq!(
+        g.download().particles.len(),
+        cpu.particles.len(),
+        "same insertions"
+    );
+    assert!(
+        d < 1e-4,
+        "after {early} steps positions differ by {d:.2e} d"
+    );
+    let late = 9000 - early;
+    g.advance(late).unwrap();
+    (0..late).for_each(|_| cpu.step().unwrap());
+    let (a, b) = (stats(g.download()), stats(&cpu));
+    eprintln!(
+        "mixed pour, GPU: {} particles, CoM ({:.4}, {:.4}), {} contacts; CPU: {}, ({:.4}, {:.4}), {}",
+        a.particles, a.com[0], a.com[1], a.contacts, b.particles, b.com[0], b.com[1], b.contacts
+    );
+    assert_eq!(a.particles, b.particles);
+    assert!((a.com[0] - b.com[0]).abs() < 0.5, "centre of mass x");
+    assert!(
+        (a.com[1] - b.com[1]).abs() < 0.15 * b.com[1],
+        "centre of mass height"
+    );
+    assert!(
+        (a.contacts as f64 - b.contacts as f64).abs() < 0.2 * b.contacts as f64,
+        "contact count"
+    );
+}
+
 #[test]
 fn r6_heap_first_impact_agrees_with_the_cpu() {
     // The reduced R6 heap as written (SI units, k^n = 1e7 N/m, irregular heptagons from

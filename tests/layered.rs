@@ -58,9 +58,15 @@ fn rows_narrow_with_the_outline_and_land_gently() {
 }
 
 #[test]
-fn layered_scenes_are_refused_by_the_gpu_path_with_a_reason() {
-    let s = sim(&layered_pile(false));
-    let Some(gpu) = common::gpu("layered_scenes_are_refused") else {
+fn layered_blocks_with_point_sources_are_refused_by_the_gpu_path_with_a_reason() {
+    // The GPU path lays rows from the host and pours sources on the device; within one
+    // step their order would differ from the CPU path's, so the mix is refused.
+    let mut v = layered_pile(false);
+    v["particles"].as_array_mut().unwrap().push(json!({
+        "kind": "point_source", "material": "m", "position": [0.0, 10.0], "rate": 1.0,
+        "count": 3, "diameter": 1.0 }));
+    let s = sim(&v);
+    let Some(gpu) = common::gpu("layered_blocks_with_point_sources_are_refused") else {
         return;
     };
     let err = talus::gpu::GpuSimulation::with_gpu(s, gpu)

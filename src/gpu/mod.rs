@@ -145,17 +145,6 @@ impl GpuSimulation {
                     .into(),
             ));
         }
-        let all_polygons = sim
-            .scene
-            .particles
-            .iter()
-            .all(|c| crate::scene::polygon_of(c).is_some());
-        if matches!(sim.law, ContactLaw::OverlapArea(_)) && !all_polygons {
-            return Err(GpuError::Unsupported(
-                "disks under the overlap-area law (mixed with polygons) are not on the GPU path yet"
-                    .into(),
-            ));
-        }
         let device_state = sim.device_state.take();
         let grid = sim.grid.clone();
         let cells = grid.cell_count() as u64;
