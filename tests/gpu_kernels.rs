@@ -886,3 +886,107 @@ fn disk_overlaps_under_the_area_law_are_exact_down_to_1e_6_d() {
         );
     }
 }
+
+#[test]
+fn degenerate_polygon_contacts_vary_continuously_on_the_gpu() {
+    // The sweeps of tests/polygons.rs (a corner through a face, parallel faces turning
+    // through 0 and sliding past each other's ends, spike against spike), 400 steps
+    // each, every step a separate pair of unit squares in one scene: the GPU force is
+    // finite, continuous along each sweep, and the CPU's to 1e-3 of the sweep's largest.
+    use std::f64::consts::FRAC_PI_4;
+    use talus::overlap::polygon_polygon;
+    let n = 400;
+    let sweeps: [(&str, fn(f64) -> ([f64; 2], f64, f64)); 4] = [
+        ("corner", |s| {
+            (
+                [0.0, 0.5 + 0.5 * 2f64.sqrt() + 0.01 - 0.06 * s],
+                FRAC_PI_4,
+                0.0,
+            )
+        }),
+        ("parallel", |s| ([0.2, 1.0 - 1e-3], (s - 0.5) * 2e-3, 0.0)),
+        ("sliding", |s| ([0.9 + 0.2 * s, 1.0 - 1e-3], 0.0, 0.0)),
+        ("spikes", |s| {
+            ([(s - 0.5) * 0.02, 2f64.sqrt() - 0.01], FRAC_PI_4, FRAC_PI_4)
+        }),
+    ];
+    // Particle 2k: the moving square (i), 2k + 1: the one below it (j). List squares
+    // have a corner at 0; the sweeps' squares have their faces along the axes.
+    let mut list = Vec::new();
+    for (m, (_, config)) in sweeps.iter().enumerate() {
+        for k in 0..=n {
+            let (cj, ti, tj) = config(k as f64 / n as f64);
+            let x = 4.0 * (m * (n + 1) + k) as f64;
+            list.push(json!({ "position": [x + cj[0], 2.0 + cj[1]], "diameter": 2f64.sqrt(), "theta": ti + FRAC_PI_4 }));
+            list.push(
+                json!({ "position": [x, 2.0], "diameter": 2f64.sqrt(), "theta": tj + FRAC_PI_4 }),
+            );
+        }
+    }
+    let w = 4.0 * (4 * (n + 1)) as f64 + 4.0;
+    let mut v = common::scene_value(
+        polygons(),
+        json!([{ "kind": "list", "material": "m", "particles": list, "polygon": { "corners": 4 } }]),
+    );
+    v["domain"] = json!({ "x": [-4.0, w], "z": [-1.0, 6.0] });
+    let sim = common::sim(&v);
+    let Some(gpu) = common::gpu("degenerate_polygon_contacts_vary_continuously") else {
+        return;
+    };
+    let mut g = GpuSimulation::with_gpu(sim, gpu).expect("uploads");
+    let pairs = gpu_pairs(&mut g);
+    g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces]);
+    let host = g.download().clone();
+    let count = g.read_u32("contact_count", host.particles.len());
+    let out = g.read_contact_out(host.particles.len() * MAX_CONTACTS as usize);
+    let k_n = 2000.0;
+    let mut shapes = WorldShapes::default();
+    world_shapes(&host.particles, &mut shapes);
+    assert!(
+        pairs.iter().all(|p| p.j == p.i + 1 && p.i % 2 == 0),
+        "only partners touch"
+    );
+    for (m, (name, _)) in sweeps.iter().enumerate() {
+        let (mut gpu_f, mut cpu_f) = (Vec::new(), Vec::new());
+        for k in 0..=n {
+            let i = 2 * (m * (n + 1) + k);
+            let f = if count[i] > 0 {
+                let o = out[i * MAX_CONTACTS as usize];
+                [o.ft[0] as f64 / k_n, o.ft[1] as f64 / k_n]
+            } else {
+                [0.0, 0.0]
+            };
+            assert!(
+                f[0].is_finite() && f[1].is_finite(),
+                "{name}: step {k} not finite"
+            );
+            gpu_f.push(f);
+            let (pi, pj) = (host.particles.position(i), host.particles.position(i + 1));
+            cpu_f.push(
+                match polygon_polygon(shapes.of(i), pi, shapes.of(i + 1), pj) {
+                    Some(c) => [c.area / c.l * c.n[0], c.area / c.l * c.n[1]],
+                    None => [0.0, 0.0],
+                },
+            );
+        }
+        let scale = cpu_f.iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
+        let jump = gpu_f
+            .windows(2)
+            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+            .fold(0.0, f64::max)
+            / scale;
+        let diff = gpu_f
+            .iter()
+            .zip(&cpu_f)
+            .map(|(a, b)| (a[0] - b[0]).hypot(a[1] - b[1]))
+            .fold(0.0, f64::max)
+            / scale;
+        eprintln!("{name}: largest step {jump:.2e}, GPU vs CPU {diff:.2e} of the largest force");
+        assert!(scale > 0.0, "{name}: in contact");
+        assert!(
+            jump < 0.05,
+            "{name}: the GPU force jumps by {jump:.2e} of its size"
+        );
+        assert!(diff < 1e-3, "{name}: GPU and CPU differ by {diff:.2e}");
+    }
+}

@@ -554,3 +554,110 @@ fn a_disk_rests_on_a_square_and_the_floor_carries_both() {
         "square carries {on_square} of {disk}"
     );
 }
+
+/// The elastic force direction and size (A/l along n) of polygon i against j.
+fn overlap_force(p: &[P2], ci: P2, q: &[P2], cj: P2) -> [f64; 2] {
+    match polygon_polygon(p, ci, q, cj) {
+        Some(g) => {
+            assert!(
+                g.area.is_finite() && g.l.is_finite() && g.n[0].is_finite() && g.n[1].is_finite(),
+                "non-finite geometry"
+            );
+            [g.area / g.l * g.n[0], g.area / g.l * g.n[1]]
+        }
+        None => [0.0, 0.0],
+    }
+}
+
+/// Largest change of the force between neighbouring steps of a sweep, in units of the
+/// largest force of the sweep; and that largest force.
+fn largest_jump(steps: usize, config: impl Fn(f64) -> (Vec<P2>, P2, Vec<P2>, P2)) -> (f64, f64) {
+    let forces: Vec<[f64; 2]> = (0..=steps)
+        .map(|k| {
+            let (p, ci, q, cj) = config(k as f64 / steps as f64);
+            overlap_force(&p, ci, &q, cj)
+        })
+        .collect();
+    let scale = forces.iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
+    let jump = forces
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .fold(0.0, f64::max);
+    (jump / scale, scale)
+}
+
+#[test]
+fn degenerate_contacts_give_finite_forces_that_vary_continuously() {
+    // SPEC 2.3: a corner through a face, parallel edges, spike against spike. Each sweep
+    // passes through the degenerate configuration in 2000 steps; a flip of the normal or
+    // a jump of the force point would change the force by a good part of its size in one
+    // step, a continuous force by ~1/2000 of it per unit slope.
+    let square = |c: P2, side: f64, theta: f64| {
+        let mut w = Vec::new();
+        let body = ellipse_polygon(
+            4,
+            side * 2f64.sqrt(),
+            side * 2f64.sqrt(),
+            std::f64::consts::FRAC_PI_4,
+        );
+        world(&body, c, theta, &mut w);
+        w
+    };
+    let n = 2000;
+    // A square's corner pushed through the top face of another, from 0.01 outside to 0.05 inside.
+    let corner = largest_jump(n, |s| {
+        let cj = [0.0, 0.5 + 0.5 * 2f64.sqrt() + 0.01 - 0.06 * s];
+        (
+            square(cj, 1.0, std::f64::consts::FRAC_PI_4),
+            cj,
+            square([0.0, 0.0], 1.0, 0.0),
+            [0.0, 0.0],
+        )
+    });
+    // Parallel faces: the upper square turns through 0 (faces parallel) at overlap 1e-3.
+    let parallel = largest_jump(n, |s| {
+        let cj = [0.2, 1.0 - 1e-3];
+        (
+            square(cj, 1.0, (s - 0.5) * 2e-3),
+            cj,
+            square([0.0, 0.0], 1.0, 0.0),
+            [0.0, 0.0],
+        )
+    });
+    // Parallel faces whose ends pass each other: sliding along the face through the
+    // point where the corners meet.
+    let sliding = largest_jump(n, |s| {
+        let cj = [0.9 + 0.2 * s, 1.0 - 1e-3];
+        (
+            square(cj, 1.0, 0.0),
+            cj,
+            square([0.0, 0.0], 1.0, 0.0),
+            [0.0, 0.0],
+        )
+    });
+    // Spike against spike: two squares corner to corner, the upper one sliding sideways
+    // through exact alignment at a fixed depth.
+    let spikes = largest_jump(n, |s| {
+        let cj = [(s - 0.5) * 0.02, 2f64.sqrt() - 0.01];
+        let q = std::f64::consts::FRAC_PI_4;
+        (
+            square(cj, 1.0, q),
+            cj,
+            square([0.0, 0.0], 1.0, q),
+            [0.0, 0.0],
+        )
+    });
+    for (name, (jump, scale)) in [
+        ("corner", corner),
+        ("parallel", parallel),
+        ("sliding", sliding),
+        ("spikes", spikes),
+    ] {
+        eprintln!("{name}: largest step {jump:.2e} of the largest force {scale:.2e}");
+        assert!(scale > 0.0, "{name}: in contact");
+        assert!(
+            jump < 0.02,
+            "{name}: the force jumps by {jump:.2e} of its size"
+        );
+    }
+}
