@@ -448,7 +448,8 @@ mod tests {
     }
 }
 
-// ---- Disks under the overlap-area law (SPEC 2.3 for mixed scenes; CPU path) ----
+// ---- Disks under the overlap-area law (SPEC 2.3 for mixed scenes; the kernel twins are
+// in polygon.wgsl, built from exact depths) ----
 
 /// Signed area of the triangle (0, a, b) inside the circle of radius r about the origin:
 /// the segment ab is split where it crosses the circle; pieces inside add their triangle,
