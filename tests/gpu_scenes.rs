@@ -401,6 +401,26 @@ fn polygon_pile_agrees_with_the_cpu() {
         "polygon pile: {ng} vs {nc} contacts, positions {dp:.2e} d, normal forces {worst:.2e} of the mean, vertical sum {total:.2e}"
     );
     assert!(nc > 300, "the lattice is in contact: {nc}");
+    // Downloaded contacts carry the polygon contact point and normal (recomputed on the
+    // host), not a disk approximation.
+    let points: std::collections::BTreeMap<(u32, u32), [f64; 4]> = cpu
+        .pairs
+        .iter()
+        .zip(&cpu.contacts)
+        .map(|(p, c)| ((p.i, p.j), [c.point[0], c.point[1], c.n[0], c.n[1]]))
+        .collect();
+    let mut worst_point: f64 = 0.0;
+    for (p, c) in gs.pairs.iter().zip(&gs.contacts) {
+        if let Some(q) = points.get(&(p.i, p.j)) {
+            worst_point = worst_point
+                .max((c.point[0] - q[0]).hypot(c.point[1] - q[1]) / d)
+                .max((c.n[0] - q[2]).hypot(c.n[1] - q[3]));
+        }
+    }
+    assert!(
+        worst_point < 1e-3,
+        "contact points and normals differ by {worst_point:.2e}"
+    );
     // Measured: 3.3e-8 d and 4.4e-4 of the mean force (2.6e-3 with f32 corners).
     assert!(dp < 3e-7, "positions differ by {dp:.2e} d");
     assert!(

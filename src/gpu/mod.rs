@@ -22,7 +22,6 @@ use crate::create::{
     source::{self, SourceState},
 };
 use crate::forces::ContactForce;
-use crate::geometry::{disk_disk, disk_wall};
 use crate::law::ContactLaw;
 use crate::scene::{Creation, IntegratorKind, Layered, PointSource};
 use crate::sim::{Divergence, Simulation};
@@ -871,27 +870,28 @@ impl GpuSimulation {
         let outs: Vec<ContactOut> = self.read_buffer(&self.buffers.contact_out, 0, live * m);
         let mut pairs = Vec::new();
         let mut contacts = Vec::new();
+        // The contact point and normal are not read back: they are recomputed on the
+        // host from the downloaded state, with the CPU path's geometry.
         let parts = &self.sim.particles;
+        let mut shapes = crate::shape::WorldShapes::default();
+        crate::shape::world_shapes(parts, &mut shapes);
+        let area = matches!(self.sim.law, ContactLaw::OverlapArea(_));
+        let dt = self.sim.scene.dt;
         for i in 0..live {
             for k in 0..count[i] as usize {
                 let j = js[i * m + k];
                 let o = outs[i * m + k];
-                let pi = parts.position(i);
-                let g = if j >= WALL_BASE {
-                    disk_wall(
-                        pi,
-                        parts.radius[i],
-                        &self.sim.walls[(j - WALL_BASE) as usize],
-                    )
-                } else {
-                    disk_disk(
-                        pi,
-                        parts.radius[i],
-                        parts.position(j as usize),
-                        parts.radius[j as usize],
-                    )
-                };
-                pairs.push(Pair { i: i as u32, j });
+                let pair = Pair { i: i as u32, j };
+                let (g, _) = crate::forces::contact_input(
+                    parts,
+                    &shapes,
+                    &self.sim.walls,
+                    dt,
+                    area,
+                    pair,
+                    0.0,
+                );
+                pairs.push(pair);
                 contacts.push(ContactForce {
                     force: [o.ft[0] as f64, o.ft[1] as f64],
                     point: g.point,
