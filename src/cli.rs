@@ -51,6 +51,28 @@ enum Command {
     DefaultScene,
     /// List the GPU adapters, the limits talus uses, and what a run would choose.
     Info,
+    /// Measure a snapshot (or a run folder's final state): stresses with moving
+    /// averages, base pressure, angle of repose, coordination, force distribution,
+    /// packing fraction, f(theta), Q(r), energies. Writes CSV tables and summary.json.
+    Analyze {
+        /// A snapshot's .json, or a run folder (its final.json).
+        path: PathBuf,
+        /// Output folder (default: `analysis/` in the run folder, or next to the snapshot).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Width of the horizontal moving-average windows, in mean diameters.
+        #[arg(long, default_value_t = 14.0)]
+        window: f64,
+        /// Spacing of the window centres, in mean diameters.
+        #[arg(long, default_value_t = 1.0)]
+        step: f64,
+        /// Height of a row of windows (the lowest gives the base profile), in mean diameters.
+        #[arg(long, default_value_t = 2.0)]
+        row: f64,
+        /// Gravity's magnitude (default: the run's scene.json, else 9.81 or 1).
+        #[arg(long)]
+        g: Option<f64>,
+    },
     /// Measure particle-steps per second per backend and workload; prints JSON.
     Bench {
         /// Backends to measure.
@@ -108,6 +130,14 @@ pub fn main() -> ExitCode {
             print!("{}", device::describe());
             Ok(())
         }
+        Command::Analyze {
+            path,
+            out,
+            window,
+            step,
+            row,
+            g,
+        } => cmd_analyze(&path, out, window, step, row, g),
         Command::Bench {
             backend,
             sizes,
@@ -141,6 +171,74 @@ fn build_simulation(path: &Option<PathBuf>, overrides: &[String]) -> Result<Simu
         eprintln!("warning: {w}");
     }
     Simulation::new(scene).map_err(|e| bad_input(format!("in {name}: {e}")))
+}
+
+fn cmd_analyze(
+    path: &std::path::Path,
+    out: Option<PathBuf>,
+    window: f64,
+    step: f64,
+    row: f64,
+    g: Option<f64>,
+) -> Result<(), Failure> {
+    use talus::analyze;
+    for (name, v) in [("--window", window), ("--step", step), ("--row", row)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(bad_input(format!(
+                "{name} must be a positive number of diameters, not {v}"
+            )));
+        }
+    }
+    if let Some(g) = g.filter(|g| !(g.is_finite() && *g > 0.0)) {
+        return Err(bad_input(format!("--g must be positive, not {g}")));
+    }
+    let input = analyze::input::load(path, g).map_err(bad_input)?;
+    let dir = out.unwrap_or_else(|| {
+        if path.is_dir() {
+            path.join("analysis")
+        } else {
+            let stem = path
+                .file_stem()
+                .map_or("snapshot".into(), |s| s.to_string_lossy().into_owned());
+            path.with_file_name(format!("{stem}_analysis"))
+        }
+    });
+    let opt = analyze::Options {
+        window,
+        step,
+        row,
+        ..Default::default()
+    };
+    let a = analyze::analyze(input, &opt).map_err(bad_input)?;
+    let files = analyze::write(&a, &dir).map_err(|e| Failure {
+        code: 1,
+        message: e,
+    })?;
+    let s = &a.summary;
+    let o = &s.outline;
+    println!(
+        "{}: {} grains at t = {}; heap {:.4} high, {:.4} wide ({})",
+        s.scene, s.grains, s.time, o.height, o.width, a.input.length_unit
+    );
+    println!(
+        "angle of repose: left {:.1}° (rms {:.2e}, {} points), right {:.1}° (rms {:.2e}, {} points)",
+        s.repose_left.angle_deg,
+        s.repose_left.residual,
+        s.repose_left.points,
+        s.repose_right.angle_deg,
+        s.repose_right.residual,
+        s.repose_right.points
+    );
+    println!(
+        "coordination: {:.3} all, {:.3} without {} rattlers, {:.3} interior; packing fraction {:.3} (lower half)",
+        s.coordination.all,
+        s.coordination.without_rattlers,
+        s.coordination.rattlers,
+        s.coordination.interior,
+        s.packing_fraction_lower_half
+    );
+    println!("wrote {} files to {}", files.len(), dir.display());
+    Ok(())
 }
 
 fn cmd_check(path: Option<PathBuf>, overrides: Vec<String>) -> Result<(), Failure> {

@@ -6,6 +6,7 @@
 //! `gather_history` → `contact_forces` → `store_history` → `reduce_forces` → correct →
 //! boundaries. Scenes are JSON files (`scene`), runs are driven by `run`.
 
+pub mod analyze;
 pub mod bench;
 pub mod cell_list;
 pub mod checkpoint;

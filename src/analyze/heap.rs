@@ -1,0 +1,157 @@
+//! The heap's outline: base, top, width, the free surface, the angle of repose on each
+//! side (straight-line fits excluding apex and toe, SPEC 5), and the pressure the base
+//! wall carries.
+
+use super::input::{Grain, Touch};
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Outline {
+    pub base: f64,
+    pub top: f64,
+    pub height: f64,
+    pub left: f64,
+    pub right: f64,
+    pub width: f64,
+    pub apex_x: f64,
+}
+
+/// The outline of the grains: base the lowest bottom, top the highest top, left and
+/// right the outermost extents.
+pub fn outline(grains: &[Grain]) -> Outline {
+    let mut o = Outline {
+        base: f64::INFINITY,
+        top: f64::NEG_INFINITY,
+        height: 0.0,
+        left: f64::INFINITY,
+        right: f64::NEG_INFINITY,
+        width: 0.0,
+        apex_x: 0.0,
+    };
+    for g in grains {
+        o.base = o.base.min(g.z - g.radius);
+        if g.z + g.radius > o.top {
+            o.top = g.z + g.radius;
+            o.apex_x = g.x;
+        }
+        o.left = o.left.min(g.x - g.radius);
+        o.right = o.right.max(g.x + g.radius);
+    }
+    o.height = o.top - o.base;
+    o.width = o.right - o.left;
+    o
+}
+
+/// A point of the free surface: the highest top within a bin, and which grain it is.
+#[derive(Clone, Debug)]
+pub struct SurfacePoint {
+    pub x: f64,
+    pub z: f64,
+    pub grain: usize,
+    /// -1 left of the apex, +1 right, 0 the apex bin.
+    pub side: i8,
+    pub fitted: bool,
+}
+
+/// The free surface in bins of width `bin` across the outline.
+pub fn surface(grains: &[Grain], o: &Outline, bin: f64) -> Vec<SurfacePoint> {
+    let n = (o.width / bin).ceil().max(1.0) as usize;
+    let mut best: Vec<Option<(f64, usize)>> = vec![None; n];
+    for (k, g) in grains.iter().enumerate() {
+        let b = (((g.x - o.left) / bin).floor().max(0.0) as usize).min(n - 1);
+        let top = g.z + g.radius;
+        if best[b].is_none_or(|(z, _)| top > z) {
+            best[b] = Some((top, k));
+        }
+    }
+    let apex_bin = (((o.apex_x - o.left) / bin).floor().max(0.0) as usize).min(n - 1);
+    best.iter()
+        .enumerate()
+        .filter_map(|(b, v)| {
+            v.map(|(z, k)| SurfacePoint {
+                x: o.left + (b as f64 + 0.5) * bin,
+                z,
+                grain: k,
+                side: (b as i64 - apex_bin as i64).signum() as i8,
+                fitted: false,
+            })
+        })
+        .collect()
+}
+
+/// A straight-line fit of one free slope.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Slope {
+    /// Angle of repose in degrees (positive for a slope falling away from the apex).
+    pub angle_deg: f64,
+    /// RMS distance of the fitted points from the line, vertical, in length units.
+    pub residual: f64,
+    pub points: usize,
+}
+
+/// Fits both slopes to the surface points whose height above the base lies between
+/// `lo` and `hi` (fractions of the height), which leaves out the apex and the toe.
+pub fn repose(surface: &mut [SurfacePoint], o: &Outline, lo: f64, hi: f64) -> (Slope, Slope) {
+    let mut fit = |side: i8| {
+        let mut pts = Vec::new();
+        for p in surface.iter_mut() {
+            let h = (p.z - o.base) / o.height;
+            if p.side == side && h >= lo && h <= hi {
+                p.fitted = true;
+                pts.push((p.x, p.z));
+            }
+        }
+        let n = pts.len();
+        if n < 2 {
+            return Slope {
+                points: n,
+                angle_deg: f64::NAN,
+                residual: f64::NAN,
+            };
+        }
+        let mx = pts.iter().map(|p| p.0).sum::<f64>() / n as f64;
+        let mz = pts.iter().map(|p| p.1).sum::<f64>() / n as f64;
+        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+        let sxz: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - mz)).sum();
+        let b = sxz / sxx;
+        let res = (pts
+            .iter()
+            .map(|p| (p.1 - mz - b * (p.0 - mx)).powi(2))
+            .sum::<f64>()
+            / n as f64)
+            .sqrt();
+        Slope {
+            angle_deg: (b * -(side as f64)).atan().to_degrees(),
+            residual: res,
+            points: n,
+        }
+    };
+    (fit(-1), fit(1))
+}
+
+/// The base pressure from wall contacts: the vertical force the walls carry from grains
+/// centred within each window of `width`, per unit length, at centres every `step`.
+pub fn wall_pressure(
+    grains: &[Grain],
+    touches: &[Touch],
+    o: &Outline,
+    width: f64,
+    step: f64,
+) -> Vec<(f64, f64)> {
+    let columns = (o.width / step).floor() as usize + 1;
+    let walls: Vec<(f64, f64)> = touches
+        .iter()
+        .filter(|t| t.b.is_none())
+        .map(|t| (grains[t.a].x, t.force[1]))
+        .collect();
+    (0..columns)
+        .map(|c| {
+            let x = o.left + c as f64 * step;
+            let f: f64 = walls
+                .iter()
+                .filter(|(gx, _)| (gx - x).abs() <= 0.5 * width)
+                .map(|(_, fz)| fz)
+                .sum();
+            (x, f / width)
+        })
+        .collect()
+}

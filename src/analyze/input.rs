@@ -1,0 +1,223 @@
+//! What an analysis reads: a snapshot (particles, polygon corners, contacts) and, from
+//! the run it belongs to, gravity and friction (`scene.json`) and the energy log
+//! (`log.csv`).
+
+use crate::geometry::tangent;
+use crate::shape::{P2, area, world};
+use crate::snapshot::{self, Snapshot};
+use std::path::{Path, PathBuf};
+
+/// One particle of the snapshot.
+#[derive(Clone, Debug)]
+pub struct Grain {
+    pub id: u32,
+    pub x: f64,
+    pub z: f64,
+    pub theta: f64,
+    /// Reach: the radius of a disk, the circumscribed radius of a polygon.
+    pub radius: f64,
+    pub mass: f64,
+    pub fixed: bool,
+    /// Area of the actual shape (per unit thickness).
+    pub area: f64,
+    /// World corners (empty for a disk).
+    pub corners: Vec<P2>,
+}
+
+/// One contact: the force on `a` (and −force on `b` unless `b` is a wall) acting at
+/// `point`.
+#[derive(Clone, Debug)]
+pub struct Touch {
+    pub a: usize,
+    /// Index of the other grain, or None for a wall.
+    pub b: Option<usize>,
+    pub force: P2,
+    pub normal_force: f64,
+    pub point: P2,
+}
+
+/// A loaded snapshot with the scene facts the measurements need.
+#[derive(Clone, Debug)]
+pub struct Input {
+    pub source: PathBuf,
+    pub scene: String,
+    pub units: String,
+    pub step: u64,
+    pub time: f64,
+    pub grains: Vec<Grain>,
+    pub touches: Vec<Touch>,
+    /// Gravity's magnitude.
+    pub g: f64,
+    /// Coulomb friction coefficient of the contact law (None if unknown).
+    pub mu: Option<f64>,
+    /// The run's energy log, if found: (header, rows).
+    pub log: Option<(Vec<String>, Vec<Vec<f64>>)>,
+    /// Unit names of length, force, time (for CSV headers).
+    pub length_unit: String,
+    pub force_unit: String,
+}
+
+/// The snapshot a path names: a snapshot's .json, or a run folder (its final.json).
+pub fn snapshot_path(path: &Path) -> Result<PathBuf, String> {
+    if path.is_dir() {
+        let p = path.join("final.json");
+        if p.is_file() {
+            return Ok(p);
+        }
+        return Err(format!(
+            "{}: a run folder needs final.json (the run has not finished; give a snapshot's .json instead)",
+            path.display()
+        ));
+    }
+    if path.is_file() {
+        return Ok(path.to_path_buf());
+    }
+    Err(format!("{}: no such file or folder", path.display()))
+}
+
+/// The run folder of a snapshot: its own folder, or the parent of `snapshots/`.
+fn run_folder(snapshot: &Path) -> Option<PathBuf> {
+    let dir = snapshot.parent()?;
+    for d in [Some(dir), dir.parent()].into_iter().flatten() {
+        if d.join("scene.json").is_file() {
+            return Some(d.to_path_buf());
+        }
+    }
+    None
+}
+
+fn read_log(path: &Path) -> Option<(Vec<String>, Vec<Vec<f64>>)> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next()?.split(',').map(str::to_string).collect();
+    let rows = lines
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            l.split(',')
+                .map(|v| v.trim().parse().unwrap_or(f64::NAN))
+                .collect()
+        })
+        .collect();
+    Some((header, rows))
+}
+
+fn column<'a, T>(
+    s: &'a Snapshot,
+    name: &str,
+    get: fn(&'a Snapshot, &str) -> Option<&'a [T]>,
+) -> Result<&'a [T], String> {
+    get(s, name).ok_or_else(|| format!("the snapshot has no column {name}"))
+}
+
+/// Loads a snapshot (or a run folder's final snapshot); `g` overrides gravity.
+pub fn load(path: &Path, g: Option<f64>) -> Result<Input, String> {
+    let json = snapshot_path(path)?;
+    let s = snapshot::read(&json)?;
+    let f = |name| column(&s, name, Snapshot::f64);
+    let (xs, zs, th) = (f("particles.x")?, f("particles.z")?, f("particles.theta")?);
+    let (rs, ms) = (f("particles.radius")?, f("particles.mass")?);
+    let ids = column(&s, "particles.id", Snapshot::u32)?;
+    let counts = column(&s, "particles.corners", Snapshot::u32)?;
+    let (cx, cz) = (
+        s.f64("corners.x").unwrap_or(&[]),
+        s.f64("corners.z").unwrap_or(&[]),
+    );
+    let fixed: Vec<bool> = match s.columns.get("particles.fixed") {
+        Some(snapshot::Column::U8(v)) => v.iter().map(|&b| b != 0).collect(),
+        _ => vec![false; ids.len()],
+    };
+    let mut grains = Vec::with_capacity(ids.len());
+    let mut next = 0usize;
+    let mut body = Vec::new();
+    let mut index = std::collections::HashMap::new();
+    for k in 0..ids.len() {
+        let n = counts[k] as usize;
+        body.clear();
+        for m in next..next + n {
+            body.push([cx[m], cz[m]]);
+        }
+        next += n;
+        let mut corners = Vec::new();
+        let a = if n >= 3 {
+            world(&body, [xs[k], zs[k]], th[k], &mut corners);
+            area(&body)
+        } else {
+            std::f64::consts::PI * rs[k] * rs[k]
+        };
+        index.insert(ids[k], k);
+        grains.push(Grain {
+            id: ids[k],
+            x: xs[k],
+            z: zs[k],
+            theta: th[k],
+            radius: rs[k],
+            mass: ms[k],
+            fixed: fixed[k],
+            area: a,
+            corners,
+        });
+    }
+    let ci = column(&s, "contacts.i", Snapshot::u32)?;
+    let cj = column(&s, "contacts.j", Snapshot::u32)?;
+    let (nx, nz) = (f("contacts.nx")?, f("contacts.nz")?);
+    let (fnm, ftm) = (f("contacts.fn")?, f("contacts.ft")?);
+    let (px, pz) = (f("contacts.px")?, f("contacts.pz")?);
+    let mut touches = Vec::with_capacity(ci.len());
+    for k in 0..ci.len() {
+        // Contacts of particles no longer in the table (removed) are skipped.
+        let Some(&a) = index.get(&ci[k]) else {
+            continue;
+        };
+        let b = if cj[k] >= s.meta.wall_base {
+            None
+        } else {
+            match index.get(&cj[k]) {
+                Some(&b) => Some(b),
+                None => continue,
+            }
+        };
+        let n = [nx[k], nz[k]];
+        let t = tangent(n);
+        touches.push(Touch {
+            a,
+            b,
+            force: [fnm[k] * n[0] + ftm[k] * t[0], fnm[k] * n[1] + ftm[k] * t[1]],
+            normal_force: fnm[k],
+            point: [px[k], pz[k]],
+        });
+    }
+    let run = run_folder(&json);
+    let scene: Option<serde_json::Value> = run
+        .as_ref()
+        .and_then(|d| std::fs::read_to_string(d.join("scene.json")).ok())
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let scene_g = scene.as_ref().and_then(|v| {
+        let g = v.pointer("/gravity/g")?.as_array()?;
+        let (a, b) = (g.first()?.as_f64()?, g.get(1)?.as_f64()?);
+        Some(a.hypot(b))
+    });
+    let units = s.meta.units.clone();
+    let default_g = if units == "si" { 9.81 } else { 1.0 };
+    let mu = scene
+        .as_ref()
+        .and_then(|v| v.pointer("/contact/mu").and_then(|m| m.as_f64()));
+    let (length_unit, force_unit) = if units == "si" {
+        ("m", "N")
+    } else {
+        ("sigma", "m g")
+    };
+    Ok(Input {
+        source: json.clone(),
+        scene: s.meta.scene.clone(),
+        units,
+        step: s.meta.step,
+        time: s.meta.time,
+        grains,
+        touches,
+        g: g.or(scene_g).unwrap_or(default_g),
+        mu,
+        log: run.as_ref().and_then(|d| read_log(&d.join("log.csv"))),
+        length_unit: length_unit.into(),
+        force_unit: force_unit.into(),
+    })
+}

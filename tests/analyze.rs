@@ -1,0 +1,214 @@
+//! `talus analyze` (SPEC 5): measurements against analytic answers on small static
+//! packings, and the command's files and errors.
+
+mod common;
+use common::*;
+use serde_json::json;
+use std::path::{Path, PathBuf};
+use talus::analyze::{self, Options};
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("talus-analyze-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Writes a snapshot of `sim` into `dir` and analyses it.
+fn analyse(sim: &talus::sim::Simulation, dir: &Path, g: f64) -> analyze::Analysis {
+    analyse_with(sim, dir, g, &Options::default())
+}
+
+fn analyse_with(
+    sim: &talus::sim::Simulation,
+    dir: &Path,
+    g: f64,
+    opt: &Options,
+) -> analyze::Analysis {
+    let json = talus::snapshot::write(sim, dir, "snap").unwrap();
+    let input = analyze::input::load(&json, Some(g)).unwrap();
+    analyze::analyze(input, opt).unwrap()
+}
+
+const N: usize = 6;
+
+/// A column of N unit disks (m = 1, g = 1) on a floor, settled with strong damping.
+fn settled_column() -> talus::sim::Simulation {
+    let list: Vec<_> = (0..N)
+        .map(|k| json!({ "position": [0.0, 0.5 + k as f64], "diameter": 1.0 }))
+        .collect();
+    let law = json!({ "law": "spring_dashpot", "k_n": 1e5, "gamma_n": 100.0, "k_t": 1e4, "gamma_t": 10.0, "mu": 0.5 });
+    let mut v = scene_value(
+        law,
+        json!([{ "kind": "list", "material": "m", "particles": list }]),
+    );
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-5.0, 0.0], "to": [5.0, 0.0] }]);
+    let mut s = sim(&v);
+    for _ in 0..40_000 {
+        s.step().unwrap();
+    }
+    s
+}
+
+#[test]
+fn a_resting_column_carries_its_weight_grain_by_grain() {
+    // Grain k from the bottom has (N − k) m g pushing up at its bottom and (N − k − 1) m g
+    // pushing down at its top, both about r from its centre: Σ f ⊗ l in zz (compression
+    // positive) is (2(N − k) − 1) m g r, up to the overlaps (δ/r ~ 1e-4 here).
+    let s = settled_column();
+    let a = analyse(&s, &tmp("column"), 1.0);
+    for k in 0..N {
+        let expect = (2 * (N - k) - 1) as f64 * 0.5;
+        let m = a.moments[k];
+        assert!(
+            (m.zz / expect - 1.0).abs() < 2e-3,
+            "grain {k}: m_zz = {} against {expect}",
+            m.zz
+        );
+        assert!(
+            m.xx.abs() < 1e-6 && m.xz.abs() < 1e-6,
+            "grain {k}: no shear or side stress"
+        );
+    }
+    // The virial of the vertical forces: ∫ σ_zz dA = W (z_cm − base).
+    let sm = &a.summary;
+    assert!(
+        (sm.stress_integral_zz / sm.weight_times_height - 1.0).abs() < 2e-3,
+        "{} against {}",
+        sm.stress_integral_zz,
+        sm.weight_times_height
+    );
+    // Contacts: floor + one above for the lowest, two for the middle ones, one for the
+    // top grain, which is the column's only rattler (fewer than 2 with friction).
+    let c = &sm.coordination;
+    assert!(
+        (c.all - (2 * N - 1) as f64 / N as f64).abs() < 1e-12,
+        "Z = {}",
+        c.all
+    );
+    assert_eq!(c.rattlers, 1);
+    // The force distribution is a probability density with mean 1.
+    let bin = a.force_pdf[1].0 - a.force_pdf[0].0;
+    let total: f64 = a.force_pdf.iter().map(|p| p.1 * bin).sum();
+    let mean: f64 = a.force_pdf.iter().map(|p| p.0 * p.1 * bin).sum();
+    assert!((total - 1.0).abs() < 1e-12, "∫P = {total}");
+    assert!((mean - 1.0).abs() < 0.05, "mean f/<f> = {mean}");
+}
+
+#[test]
+fn a_lattice_pile_has_its_slope_and_the_triangular_packing_fraction() {
+    // The reduced R1 pile as built: a 30° triangle of touching disks on a triangular
+    // lattice, whose packing fraction is π/(2√3) = 0.9069. Layers two rows high, so that
+    // each holds whole rows.
+    let scene = talus::scene::load(Path::new("scenes/r1_pile_reduced.json"), &[]).unwrap();
+    let s = talus::sim::Simulation::new(scene).unwrap();
+    let opt = Options {
+        layer: 3f64.sqrt(),
+        ..Default::default()
+    };
+    let a = analyse_with(&s, &tmp("lattice"), 9.81, &opt);
+    let sm = &a.summary;
+    for slope in [&sm.repose_left, &sm.repose_right] {
+        assert!(slope.points >= 5, "{} points fitted", slope.points);
+        assert!(
+            (slope.angle_deg - 30.0).abs() < 1.5,
+            "angle {}",
+            slope.angle_deg
+        );
+    }
+    let phi = std::f64::consts::PI / (2.0 * 3f64.sqrt());
+    assert!(
+        (sm.packing_fraction_lower_half / phi - 1.0).abs() < 0.03,
+        "packing fraction {} against {phi}",
+        sm.packing_fraction_lower_half
+    );
+}
+
+#[test]
+fn aligned_ellipse_polygons_peak_in_f_theta_and_correlate_fully() {
+    // 40 heptagons on an ellipse of axes 2 : 1, all turned by 0.6 rad: f(θ) has all its
+    // weight in the bin of 0.6, and Q(r) = 1 at every distance.
+    let list: Vec<_> = (0..40)
+        .map(|k| {
+            json!({ "position": [3.0 * (k % 8) as f64, 3.0 * (k / 8) as f64 + 2.0],
+                         "theta": 0.6, "diameter": 2.0 })
+        })
+        .collect();
+    let law = json!({ "law": "overlap_area", "k_n": 2000.0, "eta_n": 0.5, "mu": 0.5 });
+    let block =
+        json!({ "kind": "list", "material": "m", "particles": list, "polygon": { "corners": 7 } });
+    let mut s = sim(&scene_value(law, json!([block])));
+    // Lists make regular polygons (no long axis): give each the ellipse shape.
+    let body = talus::shape::ellipse_polygon(7, 2.0, 1.0, 0.3);
+    s.particles.shape.iter_mut().for_each(|c| *c = body.clone());
+    let a = analyse(&s, &tmp("aligned"), 1.0);
+    assert_eq!(a.summary.oriented_grains, 40);
+    let width = std::f64::consts::PI / 18.0;
+    let peak = a
+        .orientation
+        .iter()
+        .max_by(|x, y| x.1.total_cmp(&y.1))
+        .unwrap();
+    assert!((peak.0 - 0.6).abs() <= 0.5 * width, "peak at {}", peak.0);
+    assert!(
+        (peak.1 * width - 1.0).abs() < 1e-12,
+        "all weight in one bin"
+    );
+    assert!(!a.correlation.is_empty());
+    assert!(a.correlation.iter().all(|c| (c.1 - 1.0).abs() < 1e-9));
+}
+
+#[test]
+fn the_command_writes_its_tables_and_rejects_bad_input() {
+    let s = settled_column();
+    let dir = tmp("command");
+    let json = talus::snapshot::write(&s, &dir, "snap").unwrap();
+    let run = |args: &[&str]| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let out = dir.join("analysis");
+    let (code, err) = run(&[
+        "analyze",
+        json.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--g",
+        "1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    for f in [
+        "summary.json",
+        "grains.csv",
+        "stress.csv",
+        "base_profile.csv",
+        "surface.csv",
+        "force_distribution.csv",
+        "packing.csv",
+        "orientation.csv",
+        "orientation_correlation.csv",
+    ] {
+        assert!(out.join(f).is_file(), "{f} written");
+    }
+    let header = std::fs::read_to_string(out.join("stress.csv")).unwrap();
+    assert!(
+        header.starts_with("row,z_lo [sigma],z_hi [sigma],x [sigma]"),
+        "units in the header: {}",
+        &header[..60]
+    );
+    let (code, err) = run(&["analyze", "/nonexistent/run"]);
+    assert_eq!(code, 2);
+    assert!(
+        err.contains("no such file or folder") && !err.contains("panicked"),
+        "{err}"
+    );
+    let (code, err) = run(&["analyze", json.to_str().unwrap(), "--window=-3"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--window"), "{err}");
+}
