@@ -133,10 +133,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
     let windows = stress::moving_averages(
         grains,
         &moments,
-        o.base,
-        o.top,
-        o.left,
-        o.right,
+        &o,
         opt.row * d,
         opt.window * d,
         opt.step * d,

@@ -5,6 +5,7 @@
 //! length; the dimensionless S = 2σ/(ρ g h) then needs ρ as mass per area, which cancels
 //! the thickness.
 
+use super::heap::Outline;
 use super::input::{Grain, Touch};
 
 /// A 2×2 tensor [[xx, xz], [zx, zz]].
@@ -78,20 +79,18 @@ pub struct Window {
     pub sigma: Tensor,
 }
 
-/// Horizontal moving averages (paper 000 sec. 3): rows of height `dz` from `base` up,
-/// in each a window of width `width` centred every `step` from `left` to `right`;
-/// σ = Σ moments / (width · dz).
+/// Horizontal moving averages (paper 000 sec. 3): rows of height `dz` from the base up,
+/// in each a window of width `width` centred every `step` from the left end to the
+/// right; σ = Σ moments / (width · dz).
 pub fn moving_averages(
     grains: &[Grain],
     moments: &[Tensor],
-    base: f64,
-    top: f64,
-    left: f64,
-    right: f64,
+    o: &Outline,
     dz: f64,
     width: f64,
     step: f64,
 ) -> Vec<Window> {
+    let (base, top, left, right) = (o.base, o.top, o.left, o.right);
     let rows = ((top - base) / dz).ceil().max(1.0) as usize;
     let mut by_row: Vec<Vec<usize>> = vec![Vec::new(); rows];
     for (k, g) in grains.iter().enumerate() {

@@ -101,7 +101,7 @@ mod tests {
 
     #[test]
     fn angles_split_and_join_and_wrap() {
-        for &t in &[0.0, 1e-12, 1.0, -1.0, 3.0, -3.14, 7.0, -100.0, 12345.6789] {
+        for &t in &[0.0, 1e-12, 1.0, -1.0, 3.0, -3.1, 7.0, -100.0, 12345.6789] {
             let (turn, rem) = split_angle(t);
             assert!(rem.abs() <= 0.5);
             let back = join_angle(turn, rem);
