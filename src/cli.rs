@@ -73,6 +73,28 @@ enum Command {
         #[arg(long)]
         g: Option<f64>,
     },
+    /// Pictures of a snapshot (or a run folder's final state) in PNG and SVG: grains
+    /// coloured by a field, the force network, principal-stress crosses, profile plots;
+    /// and VTK files (grains.vtp, contacts.vtp) for ParaView.
+    Render {
+        /// A snapshot's .json, or a run folder (its final.json).
+        path: PathBuf,
+        /// Output folder (default: `pictures/` in the run folder, or next to the snapshot).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// What colours the grains.
+        #[arg(long, value_enum, default_value_t = talus::render::Field::Pressure)]
+        color: talus::render::Field,
+        /// Width of the pictures in pixels.
+        #[arg(long, default_value_t = 1600)]
+        width: u32,
+        /// Moving-average window for the stress crosses, in mean diameters.
+        #[arg(long, default_value_t = 14.0)]
+        window: f64,
+        /// Gravity's magnitude (default: the run's scene.json, else 9.81 or 1).
+        #[arg(long)]
+        g: Option<f64>,
+    },
     /// Measure particle-steps per second per backend and workload; prints JSON.
     Bench {
         /// Backends to measure.
@@ -138,6 +160,14 @@ pub fn main() -> ExitCode {
             row,
             g,
         } => cmd_analyze(&path, out, window, step, row, g),
+        Command::Render {
+            path,
+            out,
+            color,
+            width,
+            window,
+            g,
+        } => cmd_render(&path, out, color, width, window, g),
         Command::Bench {
             backend,
             sizes,
@@ -241,6 +271,50 @@ fn cmd_analyze(
     Ok(())
 }
 
+fn cmd_render(
+    path: &std::path::Path,
+    out: Option<PathBuf>,
+    color: talus::render::Field,
+    width: u32,
+    window: f64,
+    g: Option<f64>,
+) -> Result<(), Failure> {
+    if !(16..=20_000).contains(&width) {
+        return Err(bad_input(format!(
+            "--width must be between 16 and 20000 pixels, not {width}"
+        )));
+    }
+    if !(window.is_finite() && window > 0.0) {
+        return Err(bad_input(format!(
+            "--window must be a positive number of diameters, not {window}"
+        )));
+    }
+    let dir = out.unwrap_or_else(|| {
+        if path.is_dir() {
+            path.join("pictures")
+        } else {
+            let stem = path
+                .file_stem()
+                .map_or("snapshot".into(), |s| s.to_string_lossy().into_owned());
+            path.with_file_name(format!("{stem}_pictures"))
+        }
+    });
+    let input = talus::analyze::input::load(path, g).map_err(bad_input)?;
+    let opt = talus::analyze::Options {
+        window,
+        ..Default::default()
+    };
+    let a = talus::analyze::analyze(input, &opt).map_err(bad_input)?;
+    let fail = |e: String| Failure {
+        code: 1,
+        message: e,
+    };
+    let mut files = talus::render::render(&a, &dir, color, width).map_err(fail)?;
+    files.extend(talus::render::vtk::write(&a, &dir).map_err(fail)?);
+    println!("wrote {} files to {}", files.len(), dir.display());
+    Ok(())
+}
+
 fn cmd_check(path: Option<PathBuf>, overrides: Vec<String>) -> Result<(), Failure> {
     let sim = build_simulation(&path, &overrides)?;
     println!(
@@ -304,7 +378,44 @@ fn cmd_run(
             out.display()
         );
     }
+    // The final state's measurements and pictures; a failure here does not undo the run.
+    match measure_and_draw(
+        &out,
+        &out.join("analysis"),
+        &out.join("pictures"),
+        &talus::analyze::Options::default(),
+        None,
+        talus::render::Field::Pressure,
+        1600,
+    ) {
+        Ok(n) if !quiet => eprintln!(
+            "measurements in {}/analysis, pictures in {}/pictures ({n} files)",
+            out.display(),
+            out.display()
+        ),
+        Ok(_) => {}
+        Err(e) => eprintln!("warning: the final state could not be analysed: {e}"),
+    }
     Ok(())
+}
+
+/// `talus analyze` and `talus render` on a snapshot or run folder: tables into
+/// `analysis`, pictures and VTK files into `pictures` (if given). Returns the file count.
+fn measure_and_draw(
+    path: &std::path::Path,
+    analysis: &std::path::Path,
+    pictures: &std::path::Path,
+    opt: &talus::analyze::Options,
+    g: Option<f64>,
+    field: talus::render::Field,
+    width: u32,
+) -> Result<usize, String> {
+    let input = talus::analyze::input::load(path, g)?;
+    let a = talus::analyze::analyze(input, opt)?;
+    let mut n = talus::analyze::write(&a, analysis)?.len();
+    n += talus::render::render(&a, pictures, field, width)?.len();
+    n += talus::render::vtk::write(&a, pictures)?.len();
+    Ok(n)
 }
 
 /// The engine for `--backend`: `gpu` insists on a GPU adapter; `auto` takes a hardware

@@ -20,6 +20,7 @@ pub mod integrate;
 pub mod law;
 pub mod overlap;
 pub mod progress;
+pub mod render;
 pub mod rng;
 pub mod run;
 pub mod scene;

@@ -212,3 +212,66 @@ fn the_command_writes_its_tables_and_rejects_bad_input() {
     assert_eq!(code, 2);
     assert!(err.contains("--window"), "{err}");
 }
+
+#[test]
+fn render_draws_pictures_and_vtk_files_of_the_column() {
+    let s = settled_column();
+    let dir = tmp("render");
+    let json = talus::snapshot::write(&s, &dir, "snap").unwrap();
+    let out = dir.join("pictures");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args([
+            "render",
+            json.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--width",
+            "400",
+            "--g",
+            "1",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    for stem in ["grains", "forces", "stress_crosses"] {
+        let png = std::fs::read(out.join(format!("{stem}.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n", "{stem}.png is a PNG");
+        // Width in the IHDR chunk.
+        assert_eq!(u32::from_be_bytes(png[16..20].try_into().unwrap()), 400);
+        let svg = std::fs::read_to_string(out.join(format!("{stem}.svg"))).unwrap();
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    }
+    // One line per contact in the force network, the widest for the largest force (the
+    // floor contact carries all N grains, the top one only itself).
+    let svg = std::fs::read_to_string(out.join("forces.svg")).unwrap();
+    let widths: Vec<f64> = svg
+        .lines()
+        .filter(|l| l.starts_with("<line"))
+        .map(|l| {
+            let w = l.split("stroke-width=\"").nth(1).unwrap();
+            w[..w.find('"').unwrap()].parse().unwrap()
+        })
+        .collect();
+    assert_eq!(widths.len(), N, "N contacts: {} lines", widths.len());
+    let (wmin, wmax) = widths
+        .iter()
+        .fold((f64::MAX, 0.0f64), |(a, b), &w| (a.min(w), b.max(w)));
+    assert!(
+        (wmax / wmin - N as f64).abs() < 0.05 * N as f64,
+        "widths ∝ force: {wmin} .. {wmax}"
+    );
+    // VTK: N grains as polygons, N contacts as lines.
+    let vtp = std::fs::read_to_string(out.join("grains.vtp")).unwrap();
+    assert!(
+        vtp.contains(&format!("NumberOfPolys=\"{N}\"")),
+        "grains.vtp"
+    );
+    let vtp = std::fs::read_to_string(out.join("contacts.vtp")).unwrap();
+    assert!(
+        vtp.contains(&format!("NumberOfLines=\"{N}\"")),
+        "contacts.vtp"
+    );
+    for f in ["base_profile.svg", "force_distribution.svg"] {
+        assert!(out.join(f).is_file(), "{f}");
+    }
+}

@@ -224,6 +224,16 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
     args.extend(common);
     let (code, _, err) = talus(&args);
     assert_eq!(code, 0, "{err}");
+    // A finished run measures and draws its final state.
+    for f in [
+        "analysis/summary.json",
+        "analysis/stress.csv",
+        "pictures/forces.png",
+        "pictures/grains.svg",
+        "pictures/grains.vtp",
+    ] {
+        assert!(first.join(f).is_file(), "{f} written at the end of the run");
+    }
     let ckpt = first.join("checkpoints/ckpt_0000002000.bin");
     let second = dir.join("second");
     let (code, _, err) = talus(&[

@@ -1,0 +1,367 @@
+//! `talus render`: pictures of an analysed snapshot, in PNG (tiny-skia) and SVG: the
+//! grains in their true shapes coloured by a field, the force network with line width
+//! proportional to the normal force (paper 000 Fig. 9 and 11), the principal stresses
+//! of the moving-average windows as crosses (Fig. 12), and plots of the profiles
+//! (plotters): S_zz and S_xx along the base, P(f/⟨f⟩), f(θ).
+
+pub mod plots;
+pub mod vtk;
+
+use crate::analyze::Analysis;
+use crate::files::write_atomic;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
+
+/// What colours the grains.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Field {
+    /// The grain's own pressure, (σ_max + σ_min)/2 of Σ f ⊗ l over its area.
+    Pressure,
+    /// Its number of contacts.
+    Contacts,
+    /// Its orientation (the long axis of a polygon).
+    Orientation,
+    /// One colour; fixed grains grey.
+    Plain,
+}
+
+/// Perceptually even colours from dark blue through green to yellow (viridis, sampled).
+const RAMP: [[u8; 3]; 9] = [
+    [68, 1, 84],
+    [71, 44, 122],
+    [59, 81, 139],
+    [44, 113, 142],
+    [33, 144, 141],
+    [39, 173, 129],
+    [92, 200, 99],
+    [170, 220, 50],
+    [253, 231, 37],
+];
+
+fn ramp(t: f64) -> [u8; 3] {
+    let t = if t.is_finite() {
+        t.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let x = t * (RAMP.len() - 1) as f64;
+    let k = (x.floor() as usize).min(RAMP.len() - 2);
+    let f = x - k as f64;
+    let mix = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
+    [
+        mix(RAMP[k][0], RAMP[k + 1][0]),
+        mix(RAMP[k][1], RAMP[k + 1][1]),
+        mix(RAMP[k][2], RAMP[k + 1][2]),
+    ]
+}
+
+/// The value of `field` per grain, scaled to [0, 1] (by its 2nd and 98th percentiles).
+fn field_values(a: &Analysis, field: Field) -> Vec<f64> {
+    let raw: Vec<f64> = a
+        .input
+        .grains
+        .iter()
+        .enumerate()
+        .map(|(k, g)| match field {
+            Field::Pressure => {
+                let (smax, smin, _) = a.moments[k].scaled(1.0 / g.area).principal();
+                0.5 * (smax + smin)
+            }
+            Field::Contacts => a.counts[k] as f64,
+            Field::Orientation => a.axes[k].unwrap_or(f64::NAN) / std::f64::consts::PI,
+            Field::Plain => 0.6,
+        })
+        .collect();
+    if matches!(field, Field::Orientation | Field::Plain) {
+        return raw;
+    }
+    let mut sorted: Vec<f64> = raw.iter().copied().filter(|v| v.is_finite()).collect();
+    sorted.sort_by(f64::total_cmp);
+    if sorted.is_empty() {
+        return raw;
+    }
+    let q = |p: f64| sorted[((sorted.len() - 1) as f64 * p).round() as usize];
+    let (lo, hi) = (q(0.02), q(0.98));
+    raw.iter()
+        .map(|v| if hi > lo { (v - lo) / (hi - lo) } else { 0.5 })
+        .collect()
+}
+
+/// World (length units, z up) to picture (pixels, y down).
+#[derive(Clone, Copy)]
+struct View {
+    left: f64,
+    top: f64,
+    scale: f64,
+    width: u32,
+    height: u32,
+}
+
+impl View {
+    fn of(a: &Analysis, width: u32) -> View {
+        let (mut x0, mut x1, mut z0, mut z1) = (
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        );
+        for g in &a.input.grains {
+            x0 = x0.min(g.x - g.radius);
+            x1 = x1.max(g.x + g.radius);
+            z0 = z0.min(g.z - g.radius);
+            z1 = z1.max(g.z + g.radius);
+        }
+        let pad = 0.02 * (x1 - x0).max(z1 - z0);
+        let (x0, x1, z0, z1) = (x0 - pad, x1 + pad, z0 - pad, z1 + pad);
+        let scale = width as f64 / (x1 - x0);
+        View {
+            left: x0,
+            top: z1,
+            scale,
+            width,
+            height: (((z1 - z0) * scale).ceil() as u32).max(1),
+        }
+    }
+    fn p(&self, x: f64, z: f64) -> (f32, f32) {
+        (
+            ((x - self.left) * self.scale) as f32,
+            ((self.top - z) * self.scale) as f32,
+        )
+    }
+}
+
+/// One picture, drawn once into a pixmap and once into SVG text.
+struct Canvas {
+    view: View,
+    pixmap: Pixmap,
+    svg: String,
+}
+
+impl Canvas {
+    fn new(view: View) -> Result<Canvas, String> {
+        let mut pixmap = Pixmap::new(view.width, view.height).ok_or_else(|| {
+            format!(
+                "a picture of {} × {} pixels is too large",
+                view.width, view.height
+            )
+        })?;
+        pixmap.fill(Color::WHITE);
+        let mut svg = String::new();
+        let _ = writeln!(
+            svg,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}">
+<rect width="100%" height="100%" fill="white"/>"#,
+            w = view.width,
+            h = view.height
+        );
+        Ok(Canvas { view, pixmap, svg })
+    }
+
+    fn shape(
+        &mut self,
+        g: &crate::analyze::input::Grain,
+        fill: [u8; 3],
+        stroke: Option<[u8; 3]>,
+        line: f32,
+    ) {
+        let v = self.view;
+        let path = if g.corners.len() >= 3 {
+            let mut pb = PathBuilder::new();
+            let (x, y) = v.p(g.corners[0][0], g.corners[0][1]);
+            pb.move_to(x, y);
+            for c in &g.corners[1..] {
+                let (x, y) = v.p(c[0], c[1]);
+                pb.line_to(x, y);
+            }
+            pb.close();
+            let pts: Vec<String> = g
+                .corners
+                .iter()
+                .map(|c| {
+                    let (x, y) = v.p(c[0], c[1]);
+                    format!("{x:.2},{y:.2}")
+                })
+                .collect();
+            let _ = write!(self.svg, r#"<polygon points="{}""#, pts.join(" "));
+            pb.finish()
+        } else {
+            let (x, y) = v.p(g.x, g.z);
+            let r = (g.radius * v.scale) as f32;
+            let _ = write!(self.svg, r#"<circle cx="{x:.2}" cy="{y:.2}" r="{r:.2}""#);
+            PathBuilder::from_circle(x, y, r.max(0.1))
+        };
+        let _ = write!(
+            self.svg,
+            r#" fill="rgb({},{},{})""#,
+            fill[0], fill[1], fill[2]
+        );
+        if let Some(s) = stroke {
+            let _ = write!(
+                self.svg,
+                r#" stroke="rgb({},{},{})" stroke-width="{line}""#,
+                s[0], s[1], s[2]
+            );
+        }
+        self.svg.push_str("/>\n");
+        let Some(path) = path else { return };
+        let mut paint = Paint::default();
+        paint.set_color_rgba8(fill[0], fill[1], fill[2], 255);
+        paint.anti_alias = true;
+        self.pixmap.fill_path(
+            &path,
+            &paint,
+            FillRule::Winding,
+            Transform::identity(),
+            None,
+        );
+        if let Some(s) = stroke {
+            paint.set_color_rgba8(s[0], s[1], s[2], 255);
+            let st = Stroke {
+                width: line,
+                ..Default::default()
+            };
+            self.pixmap
+                .stroke_path(&path, &paint, &st, Transform::identity(), None);
+        }
+    }
+
+    fn line(&mut self, a: (f64, f64), b: (f64, f64), width: f32, color: [u8; 3]) {
+        let v = self.view;
+        let (p, q) = (v.p(a.0, a.1), v.p(b.0, b.1));
+        let _ = writeln!(
+            self.svg,
+            r#"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}" stroke="rgb({},{},{})" stroke-width="{width:.2}" stroke-linecap="round"/>"#,
+            p.0, p.1, q.0, q.1, color[0], color[1], color[2]
+        );
+        let mut pb = PathBuilder::new();
+        pb.move_to(p.0, p.1);
+        pb.line_to(q.0, q.1);
+        let Some(path) = pb.finish() else { return };
+        let mut paint = Paint::default();
+        paint.set_color_rgba8(color[0], color[1], color[2], 255);
+        paint.anti_alias = true;
+        let st = Stroke {
+            width: width.max(0.2),
+            line_cap: tiny_skia::LineCap::Round,
+            ..Default::default()
+        };
+        self.pixmap
+            .stroke_path(&path, &paint, &st, Transform::identity(), None);
+    }
+
+    fn save(mut self, dir: &Path, stem: &str, files: &mut Vec<PathBuf>) -> Result<(), String> {
+        self.svg.push_str("</svg>\n");
+        let png = self
+            .pixmap
+            .encode_png()
+            .map_err(|e| format!("PNG encoding: {e}"))?;
+        for (ext, bytes) in [("png", png), ("svg", self.svg.into_bytes())] {
+            let p = dir.join(format!("{stem}.{ext}"));
+            write_atomic(&p, &bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+            files.push(p);
+        }
+        Ok(())
+    }
+}
+
+const GREY: [u8; 3] = [200, 200, 200];
+const INK: [u8; 3] = [30, 30, 30];
+
+/// Writes every picture of `a` into `dir`; `width` is the pictures' width in pixels.
+pub fn render(a: &Analysis, dir: &Path, field: Field, width: u32) -> Result<Vec<PathBuf>, String> {
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut files = Vec::new();
+    let view = View::of(a, width);
+    let line = (0.04 * a.summary.mean_diameter * view.scale).clamp(0.3, 2.0) as f32;
+    // Grains coloured by the field.
+    let values = field_values(a, field);
+    let mut c = Canvas::new(view)?;
+    for (k, g) in a.input.grains.iter().enumerate() {
+        let fill = if g.fixed {
+            [150, 150, 150]
+        } else if values[k].is_finite() {
+            ramp(values[k])
+        } else {
+            GREY
+        };
+        c.shape(g, fill, Some(INK), 0.5 * line);
+    }
+    c.save(dir, "grains", &mut files)?;
+    // Force network: grains faint, each contact a line from centre to centre (to the
+    // contact point for a wall), its width proportional to the normal force.
+    let mut c = Canvas::new(view)?;
+    for g in &a.input.grains {
+        c.shape(g, [235, 235, 235], Some(GREY), 0.5 * line);
+    }
+    let fmax = a
+        .input
+        .touches
+        .iter()
+        .map(|t| t.normal_force)
+        .fold(0.0, f64::max);
+    let wmax = (0.5 * a.summary.mean_diameter * view.scale) as f32;
+    if fmax > 0.0 {
+        for t in &a.input.touches {
+            if t.normal_force <= 0.0 {
+                continue;
+            }
+            let ga = &a.input.grains[t.a];
+            let end = match t.b {
+                Some(b) => (a.input.grains[b].x, a.input.grains[b].z),
+                None => (t.point[0], t.point[1]),
+            };
+            c.line(
+                (ga.x, ga.z),
+                end,
+                wmax * (t.normal_force / fmax) as f32,
+                INK,
+            );
+        }
+    }
+    c.save(dir, "forces", &mut files)?;
+    // Principal stresses of the moving-average windows: crosses at the window centres
+    // (every `row` height along each row), arms along φ and φ + π/2 proportional to σ_max
+    // and σ_min, blue for compression and red for tension.
+    let mut c = Canvas::new(view)?;
+    for g in &a.input.grains {
+        c.shape(g, [240, 240, 240], Some([225, 225, 225]), 0.5 * line);
+    }
+    let windows: Vec<&crate::analyze::stress::Window> =
+        a.windows.iter().filter(|w| w.particles > 0).collect();
+    let smax = windows
+        .iter()
+        .map(|w| {
+            let (s1, s2, _) = w.sigma.principal();
+            s1.abs().max(s2.abs())
+        })
+        .fold(0.0, f64::max);
+    if let Some(w0) = windows.first() {
+        let row_h = w0.z_hi - w0.z_lo;
+        let every =
+            ((row_h / (a.summary.options.step * a.summary.mean_diameter)).round() as usize).max(1);
+        for (k, w) in a.windows.iter().enumerate() {
+            let column =
+                (w.x - a.summary.outline.left) / (a.summary.options.step * a.summary.mean_diameter);
+            if w.particles == 0 || (column.round() as usize) % every != 0 || smax <= 0.0 {
+                continue;
+            }
+            let _ = k;
+            let (s1, s2, phi) = w.sigma.principal();
+            let z = 0.5 * (w.z_lo + w.z_hi);
+            for (s, ang) in [(s1, phi), (s2, phi + std::f64::consts::FRAC_PI_2)] {
+                let half = 0.45 * row_h * s.abs() / smax;
+                let (dx, dz) = (half * ang.cos(), half * ang.sin());
+                let color = if s >= 0.0 {
+                    [30, 60, 200]
+                } else {
+                    [200, 40, 40]
+                };
+                c.line((w.x - dx, z - dz), (w.x + dx, z + dz), 1.5 * line, color);
+            }
+        }
+    }
+    c.save(dir, "stress_crosses", &mut files)?;
+    files.extend(plots::write_plots(a, dir)?);
+    Ok(files)
+}

@@ -1,0 +1,134 @@
+//! Plots of the profiles as SVG (plotters): S_zz and S_xx along the base against
+//! X = x/l (paper 000 Fig. 3, 6, 14), P(f/⟨f⟩), and f(θ).
+
+use crate::analyze::Analysis;
+use crate::files::write_atomic;
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+type Series<'a> = (&'a str, RGBColor, Vec<(f64, f64)>);
+
+/// One line plot; `series` share the axes.
+fn plot(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+) -> Result<(), String> {
+    let pts = series
+        .iter()
+        .flat_map(|s| s.2.iter())
+        .filter(|p| p.0.is_finite() && p.1.is_finite());
+    let (mut x0, mut x1, mut y0, mut y1) =
+        (f64::INFINITY, f64::NEG_INFINITY, 0.0f64, f64::NEG_INFINITY);
+    for &(x, y) in pts {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if !(x1 > x0) {
+        x0 = 0.0;
+        x1 = 1.0;
+    }
+    if !(y1 > y0) {
+        y1 = y0 + 1.0;
+    }
+    let y1 = y1 + 0.05 * (y1 - y0);
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (800, 500)).into_drawing_area();
+        let e = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+        root.fill(&WHITE).map_err(|x| e(&x))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc(x_label)
+            .y_desc(y_label)
+            .draw()
+            .map_err(|x| e(&x))?;
+        for (name, color, data) in series {
+            let c = *color;
+            chart
+                .draw_series(LineSeries::new(
+                    data.iter().copied().filter(|p| p.1.is_finite()),
+                    c.stroke_width(2),
+                ))
+                .map_err(|x| e(&x))?
+                .label(*name)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+        }
+        if series.len() > 1 {
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.8))
+                .border_style(BLACK)
+                .draw()
+                .map_err(|x| e(&x))?;
+        }
+        root.present().map_err(|x| e(&x))?;
+    }
+    write_atomic(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
+    let o = &a.summary.outline;
+    let sc = a.summary.stress_scale;
+    let base: Vec<&crate::analyze::stress::Window> =
+        a.windows.iter().filter(|w| w.row == 0).collect();
+    let xs = |x: f64| (x - o.left) / o.width;
+    let mut files = Vec::new();
+    let p = dir.join("base_profile.svg");
+    plot(
+        &p,
+        &format!(
+            "{}: stress along the base (moving averages)",
+            a.summary.scene
+        ),
+        "X = x / l",
+        "S = 2 sigma / (rho g h)",
+        &[
+            (
+                "S_zz",
+                BLUE,
+                base.iter().map(|w| (xs(w.x), w.sigma.zz / sc)).collect(),
+            ),
+            (
+                "S_xx",
+                RED,
+                base.iter().map(|w| (xs(w.x), w.sigma.xx / sc)).collect(),
+            ),
+        ],
+    )?;
+    files.push(p);
+    let p = dir.join("force_distribution.svg");
+    plot(
+        &p,
+        "normal forces between grains",
+        "f / <f>",
+        "P(f / <f>)",
+        &[("P", BLACK, a.force_pdf.clone())],
+    )?;
+    files.push(p);
+    if a.summary.oriented_grains > 0 {
+        let p = dir.join("orientation.svg");
+        plot(
+            &p,
+            "orientation of the long axes",
+            "theta [rad]",
+            "f(theta) [1/rad]",
+            &[("f", BLACK, a.orientation.clone())],
+        )?;
+        files.push(p);
+    }
+    Ok(files)
+}
