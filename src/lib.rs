@@ -21,6 +21,7 @@ pub mod law;
 pub mod overlap;
 pub mod progress;
 pub mod render;
+pub mod reproduce;
 pub mod rng;
 pub mod run;
 pub mod scene;
