@@ -275,3 +275,41 @@ fn render_draws_pictures_and_vtk_files_of_the_column() {
         assert!(out.join(f).is_file(), "{f}");
     }
 }
+
+#[test]
+fn reproduce_r1_gives_the_papers_stress_ratio_of_one_third() {
+    // R1 reduced (paper 000 sec. 4.3): frictionless lattice pile on a fixed row; in the
+    // interior of the first mobile row S_xx/S_zz = tan² 30° = 1/3.
+    let dir = tmp("reproduce");
+    let run = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            o.status.code().unwrap_or(-1),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    };
+    let (code, err) = run(&[
+        "reproduce",
+        "R1",
+        "--backend",
+        "cpu",
+        "-q",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("reproduce.json")).unwrap())
+            .unwrap();
+    let ratio = report["variants"][0]["stress_ratio_interior_row1"]
+        .as_f64()
+        .unwrap();
+    assert!((ratio - 1.0 / 3.0).abs() < 0.03, "S_xx/S_zz = {ratio}");
+    assert!(dir.join("pile/pictures/forces.png").is_file());
+    let (code, err) = run(&["reproduce", "R12"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("unknown reproduction"), "{err}");
+}
