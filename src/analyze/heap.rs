@@ -15,9 +15,11 @@ pub struct Outline {
     pub apex_x: f64,
 }
 
-/// The outline of the grains: base the lowest bottom, top the highest top, left and
-/// right the outermost extents.
+/// The outline of the heap: base the lowest bottom of any grain (a fixed base row
+/// included), top, apex, left and right from the mobile grains (a fixed base row wider
+/// than the heap does not widen it); all grains when every grain is fixed.
 pub fn outline(grains: &[Grain]) -> Outline {
+    let any_mobile = grains.iter().any(|g| !g.fixed);
     let mut o = Outline {
         base: f64::INFINITY,
         top: f64::NEG_INFINITY,
@@ -29,6 +31,9 @@ pub fn outline(grains: &[Grain]) -> Outline {
     };
     for g in grains {
         o.base = o.base.min(g.z - g.radius);
+        if any_mobile && g.fixed {
+            continue;
+        }
         if g.z + g.radius > o.top {
             o.top = g.z + g.radius;
             o.apex_x = g.x;
@@ -56,7 +61,11 @@ pub struct SurfacePoint {
 pub fn surface(grains: &[Grain], o: &Outline, bin: f64) -> Vec<SurfacePoint> {
     let n = (o.width / bin).ceil().max(1.0) as usize;
     let mut best: Vec<Option<(f64, usize)>> = vec![None; n];
+    let any_mobile = grains.iter().any(|g| !g.fixed);
     for (k, g) in grains.iter().enumerate() {
+        if (any_mobile && g.fixed) || g.x < o.left || g.x > o.right {
+            continue;
+        }
         let b = (((g.x - o.left) / bin).floor().max(0.0) as usize).min(n - 1);
         let top = g.z + g.radius;
         if best[b].is_none_or(|(z, _)| top > z) {
