@@ -72,6 +72,10 @@ enum Command {
         /// Gravity's magnitude (default: the run's scene.json, else 9.81 or 1).
         #[arg(long)]
         g: Option<f64>,
+        /// Average the stress tables over the run's snapshots from this time on (and
+        /// the final state); needs a run folder.
+        #[arg(long)]
+        from: Option<f64>,
     },
     /// Pictures of a snapshot (or a run folder's final state) in PNG and SVG: grains
     /// coloured by a field, the force network, principal-stress crosses, profile plots;
@@ -176,7 +180,8 @@ pub fn main() -> ExitCode {
             step,
             row,
             g,
-        } => cmd_analyze(&path, out, window, step, row, g),
+            from,
+        } => cmd_analyze(&path, out, window, step, row, g, from),
         Command::Render {
             path,
             out,
@@ -234,6 +239,7 @@ fn cmd_analyze(
     step: f64,
     row: f64,
     g: Option<f64>,
+    from: Option<f64>,
 ) -> Result<(), Failure> {
     use talus::analyze;
     for (name, v) in [("--window", window), ("--step", step), ("--row", row)] {
@@ -263,7 +269,27 @@ fn cmd_analyze(
         row,
         ..Default::default()
     };
-    let a = analyze::analyze(input, &opt).map_err(bad_input)?;
+    let mut earlier = Vec::new();
+    if let Some(t) = from {
+        if !path.is_dir() {
+            return Err(bad_input(
+                "--from needs a run folder (it averages the run's snapshots)",
+            ));
+        }
+        for p in analyze::input::snapshots_from(path, t).map_err(bad_input)? {
+            let e = analyze::input::load(&p, g).map_err(bad_input)?;
+            if e.step < input.step {
+                earlier.push(e);
+            }
+        }
+    }
+    let a = analyze::analyze_series(input, earlier, &opt).map_err(bad_input)?;
+    if a.summary.averaged_snapshots > 1 {
+        println!(
+            "stresses averaged over {} snapshots from t = {}",
+            a.summary.averaged_snapshots, a.summary.averaged_from_time
+        );
+    }
     let files = analyze::write(&a, &dir).map_err(|e| Failure {
         code: 1,
         message: e,

@@ -75,6 +75,26 @@ pub fn snapshot_path(path: &Path) -> Result<PathBuf, String> {
     Err(format!("{}: no such file or folder", path.display()))
 }
 
+/// The snapshots of a run folder at times ≥ `from` (not the final one), in time order.
+pub fn snapshots_from(run: &Path, from: f64) -> Result<Vec<PathBuf>, String> {
+    let dir = run.join("snapshots");
+    let mut found = Vec::new();
+    let entries = std::fs::read_dir(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    for e in entries.flatten() {
+        let p = e.path();
+        if p.extension().is_some_and(|x| x == "json") {
+            let text = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+            let meta: snapshot::Meta =
+                serde_json::from_str(&text).map_err(|e| format!("{}: {e}", p.display()))?;
+            if meta.time >= from {
+                found.push((meta.time, p));
+            }
+        }
+    }
+    found.sort_by(|a, b| a.0.total_cmp(&b.0));
+    Ok(found.into_iter().map(|(_, p)| p).collect())
+}
+
 /// The run folder of a snapshot: its own folder, or the parent of `snapshots/`.
 fn run_folder(snapshot: &Path) -> Option<PathBuf> {
     let dir = snapshot.parent()?;

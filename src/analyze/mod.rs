@@ -90,6 +90,10 @@ pub struct Summary {
     /// heap on a flat base (the virial of the vertical forces), a check on the data.
     pub stress_integral_zz: f64,
     pub weight_times_height: f64,
+    /// Snapshots whose stresses (`stress.csv`, `base_profile.csv`) are averaged: 1, or
+    /// more with `--from`.
+    pub averaged_snapshots: usize,
+    pub averaged_from_time: f64,
     pub options: Options,
 }
 
@@ -109,6 +113,46 @@ pub struct Analysis {
     pub axes: Vec<Option<f64>>,
     pub orientation: Vec<(f64, f64)>,
     pub correlation: Vec<(f64, f64, usize)>,
+}
+
+/// As `analyze`, with the stress tables averaged over `earlier` snapshots as well (same
+/// run, windows placed by the last snapshot's outline): time averages for packings that
+/// keep vibrating.
+pub fn analyze_series(
+    input: Input,
+    earlier: Vec<Input>,
+    opt: &Options,
+) -> Result<Analysis, String> {
+    let mut a = analyze(input, opt)?;
+    if earlier.is_empty() {
+        return Ok(a);
+    }
+    let o = a.summary.outline.clone();
+    let d = a.summary.mean_diameter;
+    let n = earlier.len() + 1;
+    let mut from = a.summary.time;
+    for e in &earlier {
+        from = from.min(e.time);
+        let m = stress::moments(&e.grains, &e.touches);
+        let w =
+            stress::moving_averages(&e.grains, &m, &o, opt.row * d, opt.window * d, opt.step * d);
+        let p = heap::wall_pressure(&e.grains, &e.touches, &o, opt.window * d, opt.step * d);
+        for (acc, x) in a.windows.iter_mut().zip(&w) {
+            acc.sigma = acc.sigma.plus(x.sigma);
+            acc.particles += x.particles;
+        }
+        for (acc, x) in a.wall_pressure.iter_mut().zip(&p) {
+            acc.1 += x.1;
+        }
+    }
+    for w in &mut a.windows {
+        w.sigma = w.sigma.scaled(1.0 / n as f64);
+        w.particles = (w.particles as f64 / n as f64).round() as usize;
+    }
+    a.wall_pressure.iter_mut().for_each(|p| p.1 /= n as f64);
+    a.summary.averaged_snapshots = n;
+    a.summary.averaged_from_time = from;
+    Ok(a)
 }
 
 pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
@@ -199,6 +243,8 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
         energy,
         stress_integral_zz: moments.iter().map(|m| m.zz).sum(),
         weight_times_height: weight_height,
+        averaged_snapshots: 1,
+        averaged_from_time: input.time,
         options: opt.clone(),
     };
     Ok(Analysis {

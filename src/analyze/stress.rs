@@ -27,6 +27,12 @@ impl Tensor {
         }
     }
 
+    pub fn plus(self, o: Tensor) -> Tensor {
+        let mut t = self;
+        t.add(o);
+        t
+    }
+
     fn add(&mut self, o: Tensor) {
         self.xx += o.xx;
         self.xz += o.xz;
