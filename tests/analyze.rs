@@ -313,3 +313,28 @@ fn reproduce_r1_gives_the_papers_stress_ratio_of_one_third() {
     assert_eq!(code, 2);
     assert!(err.contains("unknown reproduction"), "{err}");
 }
+
+#[test]
+fn stresses_average_over_snapshots() {
+    // The same column twice, once with every contact force tripled: the averaged
+    // stress tables are twice the single one; everything else is the last snapshot's.
+    let s = settled_column();
+    let json = talus::snapshot::write(&s, &tmp("series"), "snap").unwrap();
+    let one = analyze::input::load(&json, Some(1.0)).unwrap();
+    let mut tripled = one.clone();
+    tripled.touches.iter_mut().for_each(|t| {
+        t.force = [3.0 * t.force[0], 3.0 * t.force[1]];
+        t.normal_force *= 3.0;
+    });
+    let single = analyze::analyze(one.clone(), &Options::default()).unwrap();
+    let avg = analyze::analyze_series(one, vec![tripled], &Options::default()).unwrap();
+    assert_eq!(avg.summary.averaged_snapshots, 2);
+    for (a, b) in avg.windows.iter().zip(&single.windows) {
+        assert!((a.sigma.zz - 2.0 * b.sigma.zz).abs() <= 1e-12 * b.sigma.zz.abs().max(1e-300));
+        assert!((a.sigma.xx - 2.0 * b.sigma.xx).abs() <= 1e-12 + 1e-12 * b.sigma.xx.abs());
+    }
+    assert_eq!(
+        avg.summary.forces.mean_normal,
+        single.summary.forces.mean_normal
+    );
+}
