@@ -232,6 +232,18 @@ fn build_simulation(path: &Option<PathBuf>, overrides: &[String]) -> Result<Simu
     Simulation::new(scene).map_err(|e| bad_input(format!("in {name}: {e}")))
 }
 
+/// Where results of a run folder or snapshot go by default: `NAME/` in the run folder,
+/// or `STEM_NAME/` next to the snapshot.
+fn beside(path: &std::path::Path, name: &str) -> PathBuf {
+    if path.is_dir() {
+        return path.join(name);
+    }
+    let stem = path
+        .file_stem()
+        .map_or("snapshot".into(), |s| s.to_string_lossy().into_owned());
+    path.with_file_name(format!("{stem}_{name}"))
+}
+
 fn cmd_analyze(
     path: &std::path::Path,
     out: Option<PathBuf>,
@@ -253,16 +265,7 @@ fn cmd_analyze(
         return Err(bad_input(format!("--g must be positive, not {g}")));
     }
     let input = analyze::input::load(path, g).map_err(bad_input)?;
-    let dir = out.unwrap_or_else(|| {
-        if path.is_dir() {
-            path.join("analysis")
-        } else {
-            let stem = path
-                .file_stem()
-                .map_or("snapshot".into(), |s| s.to_string_lossy().into_owned());
-            path.with_file_name(format!("{stem}_analysis"))
-        }
-    });
+    let dir = out.unwrap_or_else(|| beside(path, "analysis"));
     let opt = analyze::Options {
         window,
         step,
@@ -339,16 +342,7 @@ fn cmd_render(
             "--window must be a positive number of diameters, not {window}"
         )));
     }
-    let dir = out.unwrap_or_else(|| {
-        if path.is_dir() {
-            path.join("pictures")
-        } else {
-            let stem = path
-                .file_stem()
-                .map_or("snapshot".into(), |s| s.to_string_lossy().into_owned());
-            path.with_file_name(format!("{stem}_pictures"))
-        }
-    });
+    let dir = out.unwrap_or_else(|| beside(path, "pictures"));
     let input = talus::analyze::input::load(path, g).map_err(bad_input)?;
     let opt = talus::analyze::Options {
         window,

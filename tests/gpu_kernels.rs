@@ -687,15 +687,13 @@ fn touching_pairs(pairs: usize, seed: u64) -> talus::sim::Simulation {
     sim
 }
 
-#[test]
-fn polygon_overlaps_are_exact_down_to_1e_6_d() {
-    // SPEC 3: overlaps of resting contacts right to 1e-3 relative. Polygon overlaps of
-    // 1e-7..1e-3 d (A/l), face to face and corner first: the GPU's exact area
-    // (polygon.wgsl `exact_area`) against the f64 CPU path.
-    let sim = touching_pairs(40, 21);
-    let Some(gpu) = common::gpu("polygon_overlaps_are_exact") else {
-        return;
-    };
+/// Each contact the GPU finds in `sim` with its A/l (or overlap) on the GPU and on the
+/// CPU path at the same state; None without an adapter.
+fn gpu_and_cpu_overlaps(
+    test: &str,
+    sim: talus::sim::Simulation,
+) -> Option<(talus::sim::Simulation, Vec<(Pair, f64, f64)>)> {
+    let gpu = common::gpu(test)?;
     let mut g = GpuSimulation::with_gpu(sim, gpu).expect("uploads");
     let pairs = gpu_pairs(&mut g);
     g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces]);
@@ -704,21 +702,38 @@ fn polygon_overlaps_are_exact_down_to_1e_6_d() {
     let (cpu, _) = cpu_contact_forces(&host, &pairs, &vec![0.0; pairs.len()]);
     let out = g.read_contact_out(n * MAX_CONTACTS as usize);
     let count = g.read_u32("contact_count", n);
+    let mut rows = Vec::new();
     let mut k_global = 0;
-    // Worst error beyond 1e-3 relative, in d (= 1 here).
-    let (mut worst_face, mut worst_random, mut smallest) = (0.0f64, 0.0f64, f64::MAX);
     for i in 0..n {
         for k in 0..count[i] as usize {
             let o = out[i * MAX_CONTACTS as usize + k];
-            let c = &cpu[k_global];
-            let e = (o.info[2] as f64 - c.overlap).abs() - 1e-3 * c.overlap;
-            smallest = smallest.min(c.overlap);
-            if host.particles.shape[i].len() == 12 {
-                worst_face = worst_face.max(e);
-            } else {
-                worst_random = worst_random.max(e);
-            }
+            rows.push((pairs[k_global], o.info[2] as f64, cpu[k_global].overlap));
             k_global += 1;
+        }
+    }
+    Some((host, rows))
+}
+
+#[test]
+fn polygon_overlaps_are_exact_down_to_1e_6_d() {
+    // SPEC 3: overlaps of resting contacts right to 1e-3 relative. Polygon overlaps of
+    // 1e-7..1e-3 d (A/l), face to face and corner first: the GPU's exact area
+    // (polygon.wgsl `exact_area`) against the f64 CPU path.
+    let Some((host, rows)) =
+        gpu_and_cpu_overlaps("polygon_overlaps_are_exact", touching_pairs(40, 21))
+    else {
+        return;
+    };
+    let pairs: Vec<Pair> = rows.iter().map(|r| r.0).collect();
+    // Worst error beyond 1e-3 relative, in d (= 1 here).
+    let (mut worst_face, mut worst_random, mut smallest) = (0.0f64, 0.0f64, f64::MAX);
+    for &(p, gpu, cpu) in &rows {
+        let e = (gpu - cpu).abs() - 1e-3 * cpu;
+        smallest = smallest.min(cpu);
+        if host.particles.shape[p.i as usize].len() == 12 {
+            worst_face = worst_face.max(e);
+        } else {
+            worst_random = worst_random.max(e);
         }
     }
     eprintln!(
@@ -830,18 +845,11 @@ fn disk_overlaps_under_the_area_law_are_exact_down_to_1e_6_d() {
     // Mixed scenes (SPEC 2.3): polygon-disk, disk-disk and disk-wall area contacts at
     // k^n = 1e7 and A/l from ~1e-6 d: the GPU's exact-depth forms (polygon.wgsl, "Disks
     // under the overlap-area law") against the f64 CPU path.
-    let sim = touching_mixed(12, 5);
-    let Some(gpu) = common::gpu("disk_overlaps_under_the_area_law") else {
+    let Some((_, rows)) =
+        gpu_and_cpu_overlaps("disk_overlaps_under_the_area_law", touching_mixed(12, 5))
+    else {
         return;
     };
-    let mut g = GpuSimulation::with_gpu(sim, gpu).expect("uploads");
-    let pairs = gpu_pairs(&mut g);
-    g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces]);
-    let host = g.download().clone();
-    let n = host.particles.len();
-    let (cpu, _) = cpu_contact_forces(&host, &pairs, &vec![0.0; pairs.len()]);
-    let out = g.read_contact_out(n * MAX_CONTACTS as usize);
-    let count = g.read_u32("contact_count", n);
     let names = [
         "polygon face-disk",
         "polygon corner-disk",
@@ -850,21 +858,15 @@ fn disk_overlaps_under_the_area_law_are_exact_down_to_1e_6_d() {
     ];
     let mut worst = [0.0f64; 4];
     let mut seen = [0usize; 4];
-    let mut k_global = 0;
-    for i in 0..n {
-        for k in 0..count[i] as usize {
-            let o = out[i * MAX_CONTACTS as usize + k];
-            let c = &cpu[k_global];
-            let kind = if pairs[k_global].is_wall() {
-                3
-            } else {
-                (i / 2) % 3
-            };
-            let e = (o.info[2] as f64 - c.overlap).abs() - 1e-3 * c.overlap;
-            worst[kind] = worst[kind].max(e);
-            seen[kind] += 1;
-            k_global += 1;
-        }
+    for &(p, gpu, cpu) in &rows {
+        let kind = if p.is_wall() {
+            3
+        } else {
+            (p.i as usize / 2) % 3
+        };
+        let e = (gpu - cpu).abs() - 1e-3 * cpu;
+        worst[kind] = worst[kind].max(e);
+        seen[kind] += 1;
     }
     for k in 0..4 {
         eprintln!(

@@ -450,13 +450,13 @@ fn polygon_pour() -> talus::scene::Scene {
     common::parse(&v)
 }
 
-#[test]
-fn polygon_pour_agrees_with_the_cpu_then_statistically() {
-    let Some(mut g) = gpu_sim("polygon_pour_agrees_with_the_cpu", polygon_pour()) else {
+/// A pour on both paths: under 1e-4 d through free fall and the first impacts on the
+/// floor (from t = 1.4), f32 against f64; then the same statistics.
+fn assert_pour_agrees(name: &str, scene: fn() -> talus::scene::Scene) {
+    let Some(mut g) = gpu_sim(name, scene()) else {
         return;
     };
-    let mut cpu = Simulation::new(polygon_pour()).unwrap();
-    // Free fall and the first impacts on the floor (from t = 1.4): f32 against f64.
+    let mut cpu = Simulation::new(scene()).unwrap();
     let early = 800;
     g.advance(early).unwrap();
     (0..early).for_each(|_| cpu.step().unwrap());
@@ -475,7 +475,7 @@ fn polygon_pour_agrees_with_the_cpu_then_statistically() {
     (0..late).for_each(|_| cpu.step().unwrap());
     let (a, b) = (stats(g.download()), stats(&cpu));
     eprintln!(
-        "polygon pour, GPU: {} particles, CoM ({:.4}, {:.4}), {} contacts; CPU: {}, ({:.4}, {:.4}), {}",
+        "{name}, GPU: {} particles, CoM ({:.4}, {:.4}), {} contacts; CPU: {}, ({:.4}, {:.4}), {}",
         a.particles, a.com[0], a.com[1], a.contacts, b.particles, b.com[0], b.com[1], b.contacts
     );
     assert_eq!(a.particles, b.particles);
@@ -488,6 +488,11 @@ fn polygon_pour_agrees_with_the_cpu_then_statistically() {
         (a.contacts as f64 - b.contacts as f64).abs() < 0.2 * b.contacts as f64,
         "contact count"
     );
+}
+
+#[test]
+fn polygon_pour_agrees_with_the_cpu_then_statistically() {
+    assert_pour_agrees("polygon_pour_agrees_with_the_cpu", polygon_pour);
 }
 
 /// The heptagon pour with a second source pouring disks beside it (SPEC 2.3 mixed
@@ -505,42 +510,7 @@ fn mixed_pour() -> talus::scene::Scene {
 
 #[test]
 fn mixed_pour_agrees_with_the_cpu_then_statistically() {
-    let Some(mut g) = gpu_sim("mixed_pour_agrees_with_the_cpu", mixed_pour()) else {
-        return;
-    };
-    let mut cpu = Simulation::new(mixed_pour()).unwrap();
-    // Free fall and the first impacts on the floor (from t = 1.4): f32 against f64.
-    let early = 800;
-    g.advance(early).unwrap();
-    (0..early).for_each(|_| cpu.step().unwrap());
-    let d = max_position_difference(g.download(), &cpu, 1.0);
-    assert_eq!(
-        g.download().particles.len(),
-        cpu.particles.len(),
-        "same insertions"
-    );
-    assert!(
-        d < 1e-4,
-        "after {early} steps positions differ by {d:.2e} d"
-    );
-    let late = 9000 - early;
-    g.advance(late).unwrap();
-    (0..late).for_each(|_| cpu.step().unwrap());
-    let (a, b) = (stats(g.download()), stats(&cpu));
-    eprintln!(
-        "mixed pour, GPU: {} particles, CoM ({:.4}, {:.4}), {} contacts; CPU: {}, ({:.4}, {:.4}), {}",
-        a.particles, a.com[0], a.com[1], a.contacts, b.particles, b.com[0], b.com[1], b.contacts
-    );
-    assert_eq!(a.particles, b.particles);
-    assert!((a.com[0] - b.com[0]).abs() < 0.5, "centre of mass x");
-    assert!(
-        (a.com[1] - b.com[1]).abs() < 0.15 * b.com[1],
-        "centre of mass height"
-    );
-    assert!(
-        (a.contacts as f64 - b.contacts as f64).abs() < 0.2 * b.contacts as f64,
-        "contact count"
-    );
+    assert_pour_agrees("mixed_pour_agrees_with_the_cpu", mixed_pour);
 }
 
 #[test]
@@ -582,23 +552,8 @@ fn r6_heap_first_impact_agrees_with_the_cpu() {
     );
 }
 
-/// The layered pile of tests/layered.rs: rows of 16, 13, 10, 7, 4 and 1 particles
-/// (unit diameter) dropped every 1.5 s from 0.3 d above the pile.
 fn layered_pile(polygons: bool) -> talus::scene::Scene {
-    let mut block = json!({ "kind": "layered", "material": "m", "diameter": 1.0,
-                            "base_width": 16.0, "slope": 30.0, "interval": 1.5, "gap": 0.3 });
-    let law = if polygons {
-        block["polygon"] = json!({ "corners": 7 });
-        json!({ "law": "overlap_area", "k_n": 2000.0, "eta_n": 0.5, "mu": 0.5 })
-    } else {
-        json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 10.0, "k_t": 571.4, "gamma_t": 2.0, "mu": 0.5 })
-    };
-    let mut v = common::scene_value(law, json!([block]));
-    v["dt"] = json!(0.002);
-    v["gravity"] = json!({ "g": [0.0, -1.0] });
-    v["domain"] = json!({ "x": [-30.0, 30.0], "z": [-2.0, 20.0] });
-    v["walls"] = json!([{ "from": [-30.0, 0.0], "to": [30.0, 0.0] }]);
-    common::parse(&v)
+    common::parse(&common::layered_pile(polygons))
 }
 
 #[test]

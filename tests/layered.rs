@@ -5,22 +5,6 @@ mod common;
 use common::*;
 use serde_json::json;
 
-fn layered_pile(polygons: bool) -> serde_json::Value {
-    let mut block = json!({ "kind": "layered", "material": "m", "diameter": 1.0,
-                            "base_width": 16.0, "slope": 30.0, "interval": 1.5, "gap": 0.3 });
-    let law = if polygons {
-        block["polygon"] = json!({ "corners": 7 });
-        json!({ "law": "overlap_area", "k_n": 2000.0, "eta_n": 0.5, "mu": 0.5 })
-    } else {
-        json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 10.0, "k_t": 571.4, "gamma_t": 2.0, "mu": 0.5 })
-    };
-    let mut v = scene_value(law, json!([block]));
-    v["dt"] = json!(0.002);
-    v["gravity"] = json!({ "g": [0.0, -1.0] });
-    v["walls"] = json!([{ "from": [-30.0, 0.0], "to": [30.0, 0.0] }]);
-    v
-}
-
 #[test]
 fn rows_narrow_with_the_outline_and_land_gently() {
     for polygons in [false, true] {

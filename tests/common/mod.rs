@@ -92,3 +92,22 @@ pub fn gpu(test: &str) -> Option<talus::gpu::device::Gpu> {
         Err(e) => panic!("TALUS_REQUIRE_GPU=1 and {test} has no GPU: {e}"),
     }
 }
+
+/// A layer-by-layer pile: rows of 16, 13, 10, 7, 4 and 1 unit particles (30° outline)
+/// dropped every 1.5 s from 0.3 d above the pile onto a floor; disks or heptagons.
+pub fn layered_pile(polygons: bool) -> serde_json::Value {
+    let mut block = json!({ "kind": "layered", "material": "m", "diameter": 1.0,
+                            "base_width": 16.0, "slope": 30.0, "interval": 1.5, "gap": 0.3 });
+    let law = if polygons {
+        block["polygon"] = json!({ "corners": 7 });
+        json!({ "law": "overlap_area", "k_n": 2000.0, "eta_n": 0.5, "mu": 0.5 })
+    } else {
+        json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 10.0, "k_t": 571.4, "gamma_t": 2.0, "mu": 0.5 })
+    };
+    let mut v = scene_value(law, json!([block]));
+    v["domain"] = json!({ "x": [-30.0, 30.0], "z": [-2.0, 20.0] });
+    v["dt"] = json!(0.002);
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-30.0, 0.0], "to": [30.0, 0.0] }]);
+    v
+}
