@@ -99,6 +99,13 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
             14.0,
             2.0,
         )],
+        "R7" if !full => {
+            return Err(
+                "R7 has no reduced form: with a tenth of the grains the wedge heaps spread \
+                        into a layer a few grains high (tried); run `talus reproduce R7 --full`"
+                    .into(),
+            );
+        }
         "R7" => vec![
             r7("wedge-mono", R7_MONO, 2600, 13.333333333333334),
             r7("wedge-medium", R7_MEDIUM, 3000, 13.333333333333334),

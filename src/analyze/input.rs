@@ -24,6 +24,28 @@ pub struct Grain {
     pub corners: Vec<P2>,
 }
 
+impl Grain {
+    /// Lowest and highest point of the grain's shape.
+    pub fn bottom(&self) -> f64 {
+        if self.corners.is_empty() {
+            return self.z - self.radius;
+        }
+        self.corners
+            .iter()
+            .map(|c| c[1])
+            .fold(f64::INFINITY, f64::min)
+    }
+    pub fn top(&self) -> f64 {
+        if self.corners.is_empty() {
+            return self.z + self.radius;
+        }
+        self.corners
+            .iter()
+            .map(|c| c[1])
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
 /// One contact: the force on `a` (and −force on `b` unless `b` is a wall) acting at
 /// `point`.
 #[derive(Clone, Debug)]

@@ -171,7 +171,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
         .sum::<f64>()
         / grains.len() as f64;
     let density = total_mass / total_area;
-    let o = heap::outline(grains);
+    let o = heap::trimmed(grains, d);
     let scale = 0.5 * density * input.g * o.height;
     let moments = stress::moments(grains, &input.touches);
     let windows = stress::moving_averages(

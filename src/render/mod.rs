@@ -99,21 +99,11 @@ struct View {
 }
 
 impl View {
+    /// The heap's outline with a margin (grains that rolled far away fall outside).
     fn of(a: &Analysis, width: u32) -> View {
-        let (mut x0, mut x1, mut z0, mut z1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-        );
-        for g in &a.input.grains {
-            x0 = x0.min(g.x - g.radius);
-            x1 = x1.max(g.x + g.radius);
-            z0 = z0.min(g.z - g.radius);
-            z1 = z1.max(g.z + g.radius);
-        }
-        let pad = 0.02 * (x1 - x0).max(z1 - z0);
-        let (x0, x1, z0, z1) = (x0 - pad, x1 + pad, z0 - pad, z1 + pad);
+        let o = &a.summary.outline;
+        let pad = 0.04 * o.width.max(o.height);
+        let (x0, x1, z0, z1) = (o.left - pad, o.right + pad, o.base - pad, o.top + pad);
         let scale = width as f64 / (x1 - x0);
         View {
             left: x0,
