@@ -338,3 +338,24 @@ fn stresses_average_over_snapshots() {
         single.summary.forces.mean_normal
     );
 }
+
+#[test]
+fn grains_that_rolled_away_do_not_widen_the_heap() {
+    // The lattice pile with three grains moved far out onto the floor: the outline, and
+    // with it X = x/l and the slopes, stay those of the pile.
+    let scene = talus::scene::load(Path::new("scenes/r1_pile_reduced.json"), &[]).unwrap();
+    let mut s = talus::sim::Simulation::new(scene).unwrap();
+    let plain = analyse(&s, &tmp("plain"), 9.81).summary;
+    let n = s.particles.len();
+    let r = s.particles.radius[n - 1];
+    for (k, x) in [(n - 1, 0.2), (n - 2, -0.15), (n - 3, 0.3)] {
+        s.particles.q[0][k] = [x, r, 0.0];
+    }
+    let strays = analyse(&s, &tmp("strays"), 9.81).summary;
+    let (a, b) = (&plain.outline, &strays.outline);
+    assert!(
+        (a.left - b.left).abs() < 1e-12 && (a.right - b.right).abs() < 1e-12,
+        "{a:?} vs {b:?}"
+    );
+    assert!((plain.repose_left.angle_deg - strays.repose_left.angle_deg).abs() < 1.0);
+}
