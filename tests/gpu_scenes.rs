@@ -518,7 +518,7 @@ fn r6_heap_first_impact_agrees_with_the_cpu() {
     // The reduced R6 heap as written (SI units, k^n = 1e7 N/m, irregular heptagons from
     // the point source 0.4 m up, the floor) through 0.32 s: the first heptagon has hit the
     // floor corner first and bounced, four more are falling. Free fall already parts the
-    // paths: the GPU's Gear values are f32, and adding g dt^2/2 = 2e-9 m to q1 = v dt ~
+    // paths: the GPU's integrator values are f32, and adding g dt^2 = 4e-9 m to q1 = v dt ~
     // 4e-5 m every step rounds the same way each time, so velocities drift by ~6e-5
     // relative over 0.15 s (5e-4 d in position). After the second heptagon lands on the
     // first (t = 0.35 s) corner collisions amplify any difference, so later times can

@@ -448,6 +448,26 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 ));
             }
         }
+        if let (
+            crate::law::ContactLaw::OverlapArea(l),
+            Some(m),
+            crate::scene::IntegratorKind::Gear5,
+        ) = (&law, lightest_mass(scene), scene.integrator)
+        {
+            // The same bound for the overlap-area law, whose damping γ^n = η^n sqrt(m12 k^n)
+            // acts through L/l ≈ FACE_STIFFNESS and also turns the grains. Measured on the
+            // R8 pile with Gear (μ = 0, η^n = 1): 0.8 and 0.4 pump the kinetic energy up to
+            // the elastic energy, 0.1 settles; leapfrog settles at 0.4.
+            let gamma =
+                l.eta_n * (0.5 * m * l.k_n).sqrt() * crate::law::overlap_area::FACE_STIFFNESS;
+            let ratio = 6.0 * gamma * scene.dt / m;
+            if ratio > DAMPING_STABILITY {
+                warnings.push(format!(
+                    "6·gamma_n·(L/l)·dt/m = {ratio:.2} for the lightest polygon exceeds {DAMPING_STABILITY}: Gear's predictor-corrector pumps energy into damped polygon contacts at this step (a steady vibration instead of a settled pile); use \"integrator\": \"leapfrog\" or dt ≤ {:.3e}",
+                    scene.dt * DAMPING_STABILITY / ratio
+                ));
+            }
+        }
         if scene.dt > tc / RECOMMENDED_STEPS_PER_CONTACT {
             warnings.push(format!("dt = {} exceeds t_c/10 = {:.4e} for the stiffest contact; contacts are resolved by fewer than 10 steps", scene.dt, tc / 10.0));
         }
