@@ -2,6 +2,15 @@
 //! printed once here. Exit codes: 0 success, 1 failed run (divergence, I/O), 2 bad input.
 
 use clap::{Parser, Subcommand};
+
+/// println! that ignores a closed stdout (`talus analyze ... | head`) instead of
+/// panicking.
+macro_rules! out {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout(), $($t)*);
+    }};
+}
 use std::path::PathBuf;
 use std::process::ExitCode;
 use talus::gpu::GpuSimulation;
@@ -166,11 +175,11 @@ pub fn main() -> ExitCode {
         } => cmd_run(scene, out, overrides, resume, backend, quiet),
         Command::Check { scene, overrides } => cmd_check(scene, overrides),
         Command::DefaultScene => {
-            print!("{}", scene::DEFAULT_SCENE);
+            out!("{}", scene::DEFAULT_SCENE.trim_end());
             Ok(())
         }
         Command::Info => {
-            print!("{}", device::describe());
+            out!("{}", device::describe().trim_end());
             Ok(())
         }
         Command::Analyze {
@@ -288,9 +297,10 @@ fn cmd_analyze(
     }
     let a = analyze::analyze_series(input, earlier, &opt).map_err(bad_input)?;
     if a.summary.averaged_snapshots > 1 {
-        println!(
+        out!(
             "stresses averaged over {} snapshots from t = {}",
-            a.summary.averaged_snapshots, a.summary.averaged_from_time
+            a.summary.averaged_snapshots,
+            a.summary.averaged_from_time
         );
     }
     let files = analyze::write(&a, &dir).map_err(|e| Failure {
@@ -299,11 +309,16 @@ fn cmd_analyze(
     })?;
     let s = &a.summary;
     let o = &s.outline;
-    println!(
+    out!(
         "{}: {} grains at t = {}; heap {:.4} high, {:.4} wide ({})",
-        s.scene, s.grains, s.time, o.height, o.width, a.input.length_unit
+        s.scene,
+        s.grains,
+        s.time,
+        o.height,
+        o.width,
+        a.input.length_unit
     );
-    println!(
+    out!(
         "angle of repose: left {:.1}° (rms {:.2e}, {} points), right {:.1}° (rms {:.2e}, {} points)",
         s.repose_left.angle_deg,
         s.repose_left.residual,
@@ -312,7 +327,7 @@ fn cmd_analyze(
         s.repose_right.residual,
         s.repose_right.points
     );
-    println!(
+    out!(
         "coordination: {:.3} all, {:.3} without {} rattlers, {:.3} interior; packing fraction {:.3} (lower half)",
         s.coordination.all,
         s.coordination.without_rattlers,
@@ -320,7 +335,7 @@ fn cmd_analyze(
         s.coordination.interior,
         s.packing_fraction_lower_half
     );
-    println!("wrote {} files to {}", files.len(), dir.display());
+    out!("wrote {} files to {}", files.len(), dir.display());
     Ok(())
 }
 
@@ -355,7 +370,7 @@ fn cmd_render(
     };
     let mut files = talus::render::render(&a, &dir, color, width).map_err(fail)?;
     files.extend(talus::render::vtk::write(&a, &dir).map_err(fail)?);
-    println!("wrote {} files to {}", files.len(), dir.display());
+    out!("wrote {} files to {}", files.len(), dir.display());
     Ok(())
 }
 
@@ -412,7 +427,7 @@ fn cmd_reproduce(
         .map_err(fail)?;
         talus::render::vtk::write(&a, &dir.join("pictures")).map_err(fail)?;
         let f = reproduce::findings(&v.name, &a);
-        println!(
+        out!(
             "{id} {}: {} grains, t = {:.3}; repose {:.1}° / {:.1}°; S_xx/S_zz (row 1, interior) {:.3}; base S_zz centre {:.3}, max {:.3}, dip {:.2}",
             v.name,
             f.grains,
@@ -441,7 +456,7 @@ fn cmd_reproduce(
         code: 1,
         message: format!("{}: {e}", path.display()),
     })?;
-    println!(
+    out!(
         "{id}: {}; results in {}",
         reproduce::claim(&id),
         root.display()
@@ -451,7 +466,7 @@ fn cmd_reproduce(
 
 fn cmd_check(path: Option<PathBuf>, overrides: Vec<String>) -> Result<(), Failure> {
     let sim = build_simulation(&path, &overrides)?;
-    println!(
+    out!(
         "scene `{}`: {} particles at start ({} fixed), {} steps of dt = {}",
         sim.scene.name,
         sim.particles.len(),
@@ -611,7 +626,7 @@ fn cmd_bench(
         message: e,
     })?;
     let text = serde_json::to_string_pretty(&report).expect("report serialises");
-    println!("{text}");
+    out!("{text}");
     if let Some(path) = out {
         talus::files::write_atomic(&path, text.as_bytes()).map_err(|e| Failure {
             code: 1,
