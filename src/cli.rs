@@ -108,10 +108,10 @@ enum Command {
         #[arg(long)]
         g: Option<f64>,
     },
-    /// Run one of the papers' scenes (R1, R4, R6, R7, R8; reduced unless --full), then
+    /// Run one of the papers' scenes (R1–R8; reduced unless --full), then
     /// measure and draw it; writes reproduce.json with the numbers it is judged by.
     Reproduce {
-        /// R1, R4, R6, R7 or R8.
+        /// R1 to R8 (R7 only with --full).
         id: String,
         /// The paper's size instead of the reduced form.
         #[arg(long)]
@@ -386,6 +386,7 @@ fn cmd_reproduce(
     let variants = reproduce::variants(&id, full).map_err(bad_input)?;
     let root = out.unwrap_or_else(|| PathBuf::from("runs/reproduce").join(&id));
     let mut found = Vec::new();
+    let mut failed = Vec::new();
     for v in &variants {
         let scene = scene::parse(v.scene, &v.overrides)
             .map_err(|e| bad_input(format!("{id} {}: {e}", v.name)))?;
@@ -395,17 +396,18 @@ fn cmd_reproduce(
             eprintln!("{id} {}: {} -> {}", v.name, sim.scene.name, dir.display());
         }
         let mut engine = choose_engine(sim, backend, quiet)?;
-        run::run(
+        // A variant that fails is reported and the others still run.
+        if let Err(e) = run::run(
             &mut engine,
             &run::RunOptions {
                 out: dir.clone(),
                 quiet,
             },
-        )
-        .map_err(|e| Failure {
-            code: 1,
-            message: format!("{id} {}: {e}", v.name),
-        })?;
+        ) {
+            eprintln!("error: {id} {}: {e}", v.name);
+            failed.push(serde_json::json!({ "variant": v.name, "error": e.to_string() }));
+            continue;
+        }
         let opt = talus::analyze::Options {
             window: v.window,
             row: v.row,
@@ -428,7 +430,7 @@ fn cmd_reproduce(
         talus::render::vtk::write(&a, &dir.join("pictures")).map_err(fail)?;
         let f = reproduce::findings(&v.name, &a);
         out!(
-            "{id} {}: {} grains, t = {:.3}; repose {:.1}° / {:.1}°; S_xx/S_zz (row 1, interior) {:.3}; base S_zz centre {:.3}, max {:.3}, dip {:.2}",
+            "{id} {}: {} grains, t = {:.3}; repose {:.1}° / {:.1}°; S_xx/S_zz (row 1, interior) {:.3}; S_zz under the apex / max: base {:.3} / {:.3} (dip {:.2}), row 1 {:.3} / {:.3} (dip {:.2}); Z interior {:.2}",
             v.name,
             f.grains,
             f.time,
@@ -437,7 +439,11 @@ fn cmd_reproduce(
             f.stress_ratio_interior_row1,
             f.base_szz_centre,
             f.base_szz_max,
-            f.base_dip
+            f.base_dip,
+            f.row1_szz_centre,
+            f.row1_szz_max,
+            f.row1_dip,
+            f.coordination_interior
         );
         found.push(f);
     }
@@ -446,6 +452,7 @@ fn cmd_reproduce(
         "full": full,
         "claim": reproduce::claim(&id),
         "variants": found,
+        "failed": failed,
     });
     let path = root.join("reproduce.json");
     talus::files::write_atomic(
@@ -461,6 +468,16 @@ fn cmd_reproduce(
         reproduce::claim(&id),
         root.display()
     );
+    if !failed.is_empty() {
+        return Err(Failure {
+            code: 1,
+            message: format!(
+                "{id}: {} of {} variants failed (listed in reproduce.json)",
+                failed.len(),
+                variants.len()
+            ),
+        });
+    }
     Ok(())
 }
 

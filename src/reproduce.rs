@@ -16,6 +16,8 @@ pub struct Variant {
     pub row: f64,
 }
 
+/// Height of a lattice row, √3/2 d: window rows this high hold one row of a lattice pile.
+const LATTICE_ROW: f64 = 0.8660254037844386;
 const R1: &str = include_str!("../scenes/r1_pile.json");
 const R1_REDUCED: &str = include_str!("../scenes/r1_pile_reduced.json");
 const R4: &str = include_str!("../scenes/r4_pour.json");
@@ -33,6 +35,15 @@ const R8_REDUCED: &str = include_str!("../scenes/r8_polygon_pile_reduced.json");
 pub fn claim(id: &str) -> &'static str {
     match id {
         "R1" => "S_xx/S_zz ≈ 1/3 in the interior of row M = 1",
+        "R2" => {
+            "dip of S_zz(1) under the apex for c < 0, deepening with |c|; no dip (zig-zag) for c = 1/15"
+        }
+        "R3" => {
+            "averaged over seeds, the hump of S_zz(1) at small r_d turns into a dip at r_d = 1/30; coordination ≈ 3.96 for M ≥ 1"
+        }
+        "R5" => {
+            "M profile lost for Hooke and short-tail n = 144; flatter, more compacted heaps with polydispersity"
+        }
         "R4" => {
             "stable heap, angle of repose 35° ± 5°, base normal force with an M profile (side maxima 20–30 % above the centre)"
         }
@@ -57,34 +68,64 @@ fn v(name: &str, scene: &'static str, overrides: &[&str], window: f64, row: f64)
 
 /// The runs of reproduction `id` (R1, R4, R6, R7, R8).
 pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
-    // Reduced R7: the full scenes with fewer grains (a tenth), stopping accordingly.
-    let r7 = |name: &str, scene: &'static str, count: u32, rate: f64| {
-        let pour = count as f64 / rate;
-        let o = if full {
-            Vec::new()
-        } else {
-            vec![
-                format!("particles[0].count={}", count / 10),
-                format!("stop.time={}", pour / 10.0 + 10.0),
-                format!("stop.not_before={}", pour / 10.0),
-            ]
-        };
-        Variant {
-            name: name.into(),
-            scene,
-            overrides: o,
-            window: 14.0,
-            row: 2.0,
-        }
-    };
-    Ok(match id {
-        "R1" => vec![v(
-            "pile",
+    let r7 = |name: &str, scene: &'static str| v(name, scene, &[], 14.0, 2.0);
+    let lattice = |name: &str, set: Vec<String>| {
+        let mut x = v(
+            name,
             if full { R1 } else { R1_REDUCED },
             &[],
             if full { 14.0 } else { 6.0 },
-            1.0,
-        )],
+            LATTICE_ROW,
+        );
+        x.overrides = set;
+        x
+    };
+    Ok(match id {
+        "R1" => vec![lattice("pile", Vec::new())],
+        // R2 and R3: the R1 pile (frictionless, fixed bumpy bottom), its bottom row
+        // squeezed or stretched by c, or with size disorder r_d over several seeds. The
+        // lattice is built with the bottom row's spacing and the drawn sizes, so squeezed
+        // rows and larger grains start overlapping by up to |c| d or r_d d/2; at R1's
+        // k_n = 1e7 N/m that is thousands of weights and the pile explodes (tried).
+        // k_n = 1e4 N/m makes those overlaps a few gravity overlaps, and puts
+        // ϱ = r_d k_n/(σ d) (paper 000 sec. 4.4) below 1 for r_d = 2/3000 and above
+        // for r_d = 1/30, the paper's two regimes.
+        "R2" => [
+            ("1/15", 1.0 / 15.0),
+            ("0", 0.0),
+            ("-1/750", -1.0 / 750.0),
+            ("-1/150", -1.0 / 150.0),
+        ]
+        .iter()
+        .map(|(name, c)| {
+            let bottom = if full { 98 } else { 20 };
+            lattice(
+                &format!("c={name}"),
+                vec![
+                    format!("particles[0].spacing_c={c}"),
+                    format!("particles[0].bottom_row={bottom}"),
+                    "contact.k_n=1e4".into(),
+                ],
+            )
+        })
+        .collect(),
+        "R3" => {
+            let seeds = if full { 20 } else { 5 };
+            let mut out = Vec::new();
+            for (name, rd) in [("rd=2/3000", 2.0 / 3000.0), ("rd=1/30", 1.0 / 30.0)] {
+                for seed in 1..=seeds {
+                    out.push(lattice(
+                        &format!("{name}-seed{seed}"),
+                        vec![
+                            format!("particles[0].size_disorder={rd}"),
+                            format!("seed={seed}"),
+                            "contact.k_n=1e4".into(),
+                        ],
+                    ));
+                }
+            }
+            out
+        }
         "R4" => vec![v(
             "pour",
             if full { R4 } else { R4_REDUCED },
@@ -92,6 +133,38 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
             14.0,
             1.0,
         )],
+        // R5: R4 with the Hooke law of equal work, a short tail, and polydispersity.
+        "R5" => {
+            let base = if full { R4 } else { R4_REDUCED };
+            vec![
+                v("continuous-n36", base, &[], 14.0, 1.0),
+                // The linear spring of equal work is far softer than n = 36 at the impact
+                // speed of a 30σ drop: impacts overlap by more than half a radius.
+                v(
+                    "hooke",
+                    base,
+                    &["contact.law=hooke_equivalent", "limits.max_overlap=0.95"],
+                    14.0,
+                    1.0,
+                ),
+                // The short tail is four times as steep: a quarter of the step.
+                v("n144", base, &["contact.n=144", "dt=0.00025"], 14.0, 1.0),
+                v(
+                    "poly5",
+                    base,
+                    &["particles[1].diameter={\"uniform\":[0.95,1.05]}"],
+                    14.0,
+                    1.0,
+                ),
+                v(
+                    "poly10",
+                    base,
+                    &["particles[1].diameter={\"uniform\":[0.9,1.1]}"],
+                    14.0,
+                    1.0,
+                ),
+            ]
+        }
         "R6" => vec![v(
             "heap",
             if full { R6 } else { R6_REDUCED },
@@ -107,20 +180,10 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
             );
         }
         "R7" => vec![
-            r7("wedge-mono", R7_MONO, 2600, 13.333333333333334),
-            r7("wedge-medium", R7_MEDIUM, 3000, 13.333333333333334),
-            r7("wedge-poly", R7_POLY, 3000, 13.333333333333334),
-            {
-                let mut l = v("layered-medium", R7_LAYERED, &[], 14.0, 2.0);
-                if !full {
-                    l.overrides = vec![
-                        "particles[0].base_width=0.2".into(),
-                        "stop.time=25".into(),
-                        "stop.not_before=20".into(),
-                    ];
-                }
-                l
-            },
+            r7("wedge-mono", R7_MONO),
+            r7("wedge-medium", R7_MEDIUM),
+            r7("wedge-poly", R7_POLY),
+            r7("layered-medium", R7_LAYERED),
         ],
         "R8" => ["0", "0.3", "0.6"]
             .iter()
@@ -130,18 +193,18 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
                     if full { R8 } else { R8_REDUCED },
                     &[],
                     if full { 14.0 } else { 6.0 },
-                    1.0,
+                    LATTICE_ROW,
                 );
                 x.overrides = vec![format!("contact.mu={mu}")];
                 x
             })
             .collect(),
-        "R2" | "R3" | "R5" | "R9" => {
+        "R9" => {
             return Err(format!(
-                "{id}: its scenes are not built yet (see the README's status)"
+                "{id}: rods are not built yet (see the README's status)"
             ));
         }
-        _ => return Err(format!("unknown reproduction `{id}`: R1, R4, R6, R7 or R8")),
+        _ => return Err(format!("unknown reproduction `{id}`: R1 to R9")),
     })
 }
 
@@ -155,11 +218,14 @@ pub struct Findings {
     pub repose_right_deg: f64,
     /// S_xx/S_zz averaged over the windows of row 1 with |X − 1/2| ≤ 0.2.
     pub stress_ratio_interior_row1: f64,
-    /// The base row's S_zz: at the centre (X nearest 1/2), its maximum, and the dip
-    /// (max − centre)/max (0 when the centre is the maximum).
+    /// The base row's S_zz: under the apex (the window nearest it), its maximum, and the
+    /// dip (max − centre)/max (0 when the centre is the maximum); and the same for row 1.
     pub base_szz_centre: f64,
     pub base_szz_max: f64,
     pub base_dip: f64,
+    pub row1_szz_centre: f64,
+    pub row1_szz_max: f64,
+    pub row1_dip: f64,
     pub coordination_interior: f64,
     pub packing_fraction_lower_half: f64,
     pub kinetic_over_elastic: Option<f64>,
@@ -176,17 +242,32 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
         .filter(|w| w.sigma.zz != 0.0)
         .map(|w| w.sigma.xx / w.sigma.zz)
         .collect();
-    let base: Vec<(f64, f64)> = a
-        .windows
-        .iter()
-        .filter(|w| w.row == 0)
-        .map(|w| ((w.x - s.outline.left) / s.outline.width, w.sigma.zz / sc))
-        .collect();
-    let centre = base
-        .iter()
-        .min_by(|p, q| (p.0 - 0.5).abs().total_cmp(&(q.0 - 0.5).abs()))
-        .map_or(f64::NAN, |p| p.1);
-    let max = base.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+    // (S_zz under the apex, max S_zz, dip) of a row of windows.
+    let profile = |row: usize| {
+        let pts: Vec<(f64, f64)> = a
+            .windows
+            .iter()
+            .filter(|w| w.row == row)
+            .map(|w| (w.x, w.sigma.zz / sc))
+            .collect();
+        let apex = s.outline.apex_x;
+        let centre = pts
+            .iter()
+            .min_by(|p, q| (p.0 - apex).abs().total_cmp(&(q.0 - apex).abs()))
+            .map_or(f64::NAN, |p| p.1);
+        let max = pts.iter().map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+        (
+            centre,
+            max,
+            if max > 0.0 {
+                (max - centre) / max
+            } else {
+                f64::NAN
+            },
+        )
+    };
+    let (centre, max, dip) = profile(0);
+    let (c1, m1, d1) = profile(1);
     Findings {
         variant: variant.into(),
         grains: s.grains,
@@ -196,11 +277,10 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
         stress_ratio_interior_row1: interior.iter().sum::<f64>() / interior.len().max(1) as f64,
         base_szz_centre: centre,
         base_szz_max: max,
-        base_dip: if max > 0.0 {
-            (max - centre) / max
-        } else {
-            f64::NAN
-        },
+        base_dip: dip,
+        row1_szz_centre: c1,
+        row1_szz_max: m1,
+        row1_dip: d1,
         coordination_interior: s.coordination.interior,
         packing_fraction_lower_half: s.packing_fraction_lower_half,
         kinetic_over_elastic: s.energy.as_ref().map(|e| e.kinetic_over_elastic),
