@@ -91,10 +91,10 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
         // ϱ = r_d k_n/(σ d) (paper 000 sec. 4.4) below 1 for r_d = 2/3000 and above
         // for r_d = 1/30, the paper's two regimes.
         "R2" => [
-            ("1/15", 1.0 / 15.0),
+            ("1_15", 1.0 / 15.0),
             ("0", 0.0),
-            ("-1/750", -1.0 / 750.0),
-            ("-1/150", -1.0 / 150.0),
+            ("-1_750", -1.0 / 750.0),
+            ("-1_150", -1.0 / 150.0),
         ]
         .iter()
         .map(|(name, c)| {
@@ -112,7 +112,7 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
         "R3" => {
             let seeds = if full { 20 } else { 5 };
             let mut out = Vec::new();
-            for (name, rd) in [("rd=2/3000", 2.0 / 3000.0), ("rd=1/30", 1.0 / 30.0)] {
+            for (name, rd) in [("rd=2_3000", 2.0 / 3000.0), ("rd=1_30", 1.0 / 30.0)] {
                 for seed in 1..=seeds {
                     out.push(lattice(
                         &format!("{name}-seed{seed}"),
