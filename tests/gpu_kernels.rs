@@ -687,12 +687,15 @@ fn touching_pairs(pairs: usize, seed: u64) -> talus::sim::Simulation {
     sim
 }
 
-/// Each contact the GPU finds in `sim` with its A/l (or overlap) on the GPU and on the
-/// CPU path at the same state; None without an adapter.
+/// A contact with its A/l (or overlap) on the GPU and on the CPU path.
+type Compared = (Pair, f64, f64);
+
+/// Each contact the GPU finds in `sim`, compared at the same state; None without an
+/// adapter.
 fn gpu_and_cpu_overlaps(
     test: &str,
     sim: talus::sim::Simulation,
-) -> Option<(talus::sim::Simulation, Vec<(Pair, f64, f64)>)> {
+) -> Option<(talus::sim::Simulation, Vec<Compared>)> {
     let gpu = common::gpu(test)?;
     let mut g = GpuSimulation::with_gpu(sim, gpu).expect("uploads");
     let pairs = gpu_pairs(&mut g);
@@ -898,7 +901,9 @@ fn degenerate_polygon_contacts_vary_continuously_on_the_gpu() {
     use std::f64::consts::FRAC_PI_4;
     use talus::overlap::polygon_polygon;
     let n = 400;
-    let sweeps: [(&str, fn(f64) -> ([f64; 2], f64, f64)); 4] = [
+    // A configuration: the upper square's centre and the two orientations.
+    type Config = fn(f64) -> ([f64; 2], f64, f64);
+    let sweeps: [(&str, Config); 4] = [
         ("corner", |s| {
             (
                 [0.0, 0.5 + 0.5 * 2f64.sqrt() + 0.01 - 0.06 * s],

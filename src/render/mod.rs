@@ -333,7 +333,7 @@ pub fn render(a: &Analysis, dir: &Path, field: Field, width: u32) -> Result<Vec<
         for (k, w) in a.windows.iter().enumerate() {
             let column =
                 (w.x - a.summary.outline.left) / (a.summary.options.step * a.summary.mean_diameter);
-            if w.particles == 0 || (column.round() as usize) % every != 0 || smax <= 0.0 {
+            if w.particles == 0 || !(column.round() as usize).is_multiple_of(every) || smax <= 0.0 {
                 continue;
             }
             let _ = k;

@@ -28,11 +28,12 @@ fn plot(
         y0 = y0.min(y);
         y1 = y1.max(y);
     }
-    if !(x1 > x0) {
+    // An empty or flat series still gets axes (NaN bounds compare false too).
+    if x1.partial_cmp(&x0) != Some(std::cmp::Ordering::Greater) {
         x0 = 0.0;
         x1 = 1.0;
     }
-    if !(y1 > y0) {
+    if y1.partial_cmp(&y0) != Some(std::cmp::Ordering::Greater) {
         y1 = y0 + 1.0;
     }
     let y1 = y1 + 0.05 * (y1 - y0);
