@@ -87,7 +87,10 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
         // lattice is built with the bottom row's spacing and the drawn sizes, so squeezed
         // rows and larger grains start overlapping by up to |c| d or r_d d/2; at R1's
         // k_n = 1e7 N/m that is thousands of weights and the pile explodes (tried).
-        // k_n = 1e4 N/m makes those overlaps a few gravity overlaps, and puts
+        // R2 uses k_n = 1e5 N/m: the squeeze of c = −1/150 is then a few tens of weights
+        // (two grains fly off, the rest settles), and the dip appears; at 1e4 the squeeze
+        // is too weak to arch, at 1e6 the pile loses a third of its grains (tried). R3
+        // uses 1e4 N/m, which keeps r_d = 1/30 piles together and puts
         // ϱ = r_d k_n/(σ d) (paper 000 sec. 4.4) below 1 for r_d = 2/3000 and above
         // for r_d = 1/30, the paper's two regimes.
         "R2" => [
@@ -104,7 +107,7 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
                 vec![
                     format!("particles[0].spacing_c={c}"),
                     format!("particles[0].bottom_row={bottom}"),
-                    "contact.k_n=1e4".into(),
+                    "contact.k_n=1e5".into(),
                 ],
             )
         })
