@@ -447,10 +447,23 @@ fn cmd_reproduce(
         );
         found.push(f);
     }
+    let averages = reproduce::seed_averages(&found);
+    for a in &averages {
+        out!(
+            "{id} {} (average of {} seeds): S_zz(1) under the apex {:.3}, max {:.3}, dip {:.2}; Z interior {:.2}",
+            a.setting,
+            a.seeds,
+            a.row1_szz_apex,
+            a.row1_szz_max,
+            a.row1_dip,
+            a.coordination_interior
+        );
+    }
     let report = serde_json::json!({
         "id": id,
         "full": full,
         "claim": reproduce::claim(&id),
+        "seed_averages": averages,
         "variants": found,
         "failed": failed,
     });

@@ -229,6 +229,8 @@ pub struct Findings {
     pub row1_szz_centre: f64,
     pub row1_szz_max: f64,
     pub row1_dip: f64,
+    /// S_zz of row 1 against X − X_apex (the apex at 0), for averages over seeds.
+    pub row1_profile: Vec<(f64, f64)>,
     pub coordination_interior: f64,
     pub packing_fraction_lower_half: f64,
     pub kinetic_over_elastic: Option<f64>,
@@ -271,6 +273,12 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
     };
     let (centre, max, dip) = profile(0);
     let (c1, m1, d1) = profile(1);
+    let row1_profile = a
+        .windows
+        .iter()
+        .filter(|w| w.row == 1)
+        .map(|w| ((w.x - s.outline.apex_x) / s.outline.width, w.sigma.zz / sc))
+        .collect();
     Findings {
         variant: variant.into(),
         grains: s.grains,
@@ -284,8 +292,136 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
         row1_szz_centre: c1,
         row1_szz_max: m1,
         row1_dip: d1,
+        row1_profile,
         coordination_interior: s.coordination.interior,
         packing_fraction_lower_half: s.packing_fraction_lower_half,
         kinetic_over_elastic: s.energy.as_ref().map(|e| e.kinetic_over_elastic),
+    }
+}
+
+/// The row-1 S_zz profile averaged over the seeds of one setting (variants named
+/// `SETTING-seedN`), on the X − X_apex grid of the first seed; with its value under the
+/// apex, its maximum and the dip between them.
+#[derive(Clone, Debug, Serialize)]
+pub struct SeedAverage {
+    pub setting: String,
+    pub seeds: usize,
+    pub row1_szz_apex: f64,
+    pub row1_szz_max: f64,
+    pub row1_dip: f64,
+    pub coordination_interior: f64,
+    pub profile: Vec<(f64, f64)>,
+}
+
+pub fn seed_averages(found: &[Findings]) -> Vec<SeedAverage> {
+    let mut settings: Vec<String> = Vec::new();
+    for f in found {
+        if let Some((setting, _)) = f.variant.split_once("-seed") {
+            if !settings.iter().any(|s| s == setting) {
+                settings.push(setting.to_string());
+            }
+        }
+    }
+    settings
+        .into_iter()
+        .map(|setting| {
+            let runs: Vec<&Findings> = found
+                .iter()
+                .filter(|f| {
+                    f.variant
+                        .split_once("-seed")
+                        .is_some_and(|(s, _)| s == setting)
+                })
+                .collect();
+            // Each run's S_zz interpolated at the first run's offsets from the apex.
+            let grid: Vec<f64> = runs[0].row1_profile.iter().map(|p| p.0).collect();
+            let at = |p: &[(f64, f64)], x: f64| -> f64 {
+                let k = p.partition_point(|q| q.0 < x);
+                if k == 0 || k == p.len() {
+                    return p.get(k.min(p.len() - 1)).map_or(0.0, |q| q.1);
+                }
+                let (a, b) = (p[k - 1], p[k]);
+                a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
+            };
+            let profile: Vec<(f64, f64)> = grid
+                .iter()
+                .map(|&x| {
+                    (
+                        x,
+                        runs.iter().map(|r| at(&r.row1_profile, x)).sum::<f64>()
+                            / runs.len() as f64,
+                    )
+                })
+                .collect();
+            let apex = profile
+                .iter()
+                .min_by(|p, q| p.0.abs().total_cmp(&q.0.abs()))
+                .map_or(f64::NAN, |p| p.1);
+            let max = profile
+                .iter()
+                .map(|p| p.1)
+                .fold(f64::NEG_INFINITY, f64::max);
+            SeedAverage {
+                setting,
+                seeds: runs.len(),
+                row1_szz_apex: apex,
+                row1_szz_max: max,
+                row1_dip: if max > 0.0 {
+                    (max - apex) / max
+                } else {
+                    f64::NAN
+                },
+                coordination_interior: runs.iter().map(|r| r.coordination_interior).sum::<f64>()
+                    / runs.len() as f64,
+                profile,
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn run(name: &str, profile: Vec<(f64, f64)>) -> Findings {
+        Findings {
+            variant: name.into(),
+            grains: 1,
+            time: 0.0,
+            repose_left_deg: 0.0,
+            repose_right_deg: 0.0,
+            stress_ratio_interior_row1: 0.0,
+            base_szz_centre: 0.0,
+            base_szz_max: 0.0,
+            base_dip: 0.0,
+            row1_szz_centre: 0.0,
+            row1_szz_max: 0.0,
+            row1_dip: 0.0,
+            row1_profile: profile,
+            coordination_interior: 4.0,
+            packing_fraction_lower_half: 0.0,
+            kinetic_over_elastic: None,
+        }
+    }
+
+    #[test]
+    fn seeds_average_into_one_profile_per_setting() {
+        // Two seeds whose slopes run opposite ways average into a flat profile; the other
+        // setting's single seed is its own average.
+        let found = vec![
+            run("a-seed1", vec![(-0.2, 1.0), (0.0, 0.5), (0.2, 0.0)]),
+            run("a-seed2", vec![(-0.2, 0.0), (0.0, 0.5), (0.2, 1.0)]),
+            run("b-seed1", vec![(-0.2, 0.2), (0.0, 1.0), (0.2, 0.2)]),
+        ];
+        let av = seed_averages(&found);
+        assert_eq!(av.len(), 2);
+        assert_eq!((av[0].setting.as_str(), av[0].seeds), ("a", 2));
+        for (p, x) in av[0].profile.iter().zip([-0.2, 0.0, 0.2]) {
+            assert!(
+                (p.0 - x).abs() < 1e-15 && (p.1 - 0.5).abs() < 1e-12,
+                "{p:?}"
+            );
+        }
+        assert!((av[1].row1_szz_apex - 1.0).abs() < 1e-12 && av[1].row1_dip.abs() < 1e-12);
     }
 }
