@@ -55,6 +55,34 @@ pub enum RunError {
     },
 }
 
+/// VTK files of the snapshot just written (`output.vtk`), and `snapshots.pvd` listing
+/// every one so far.
+fn write_vtk(json: &Path, entries: &mut Vec<(f64, String, String)>) -> Result<(), RunError> {
+    let dir = json.parent().unwrap_or(Path::new("."));
+    let stem = json
+        .file_stem()
+        .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    let fail = |e: String| RunError::Io {
+        path: json.display().to_string(),
+        source: std::io::Error::other(e),
+    };
+    let input = crate::analyze::input::load(json, None).map_err(fail)?;
+    if input.grains.is_empty() {
+        return Ok(()); // nothing to draw yet (a pour before its first grain)
+    }
+    let time = input.time;
+    let a = crate::analyze::analyze(input, &crate::analyze::Options::default()).map_err(fail)?;
+    let prefix = format!("{stem}_");
+    crate::render::vtk::write_named(&a, dir, &prefix).map_err(fail)?;
+    entries.push((
+        time,
+        format!("{prefix}grains.vtp"),
+        format!("{prefix}contacts.vtp"),
+    ));
+    let pvd = dir.join("snapshots.pvd");
+    write_atomic(&pvd, crate::render::vtk::collection(entries).as_bytes()).map_err(io(&pvd))
+}
+
 fn io(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
     move |source| RunError::Io {
         path: path.display().to_string(),
@@ -174,9 +202,13 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
     );
     let mut checkpoints: Vec<PathBuf> = Vec::new();
     let mut settled = false;
+    let mut vtk_entries = Vec::new();
     if engine.step() == 0 && snap_every.is_some() {
-        snapshot::write(engine.sim(), &snap_dir, &format!("snap_{:010}", 0))
+        let json = snapshot::write(engine.sim(), &snap_dir, &format!("snap_{:010}", 0))
             .map_err(io(&snap_dir))?;
+        if o.vtk {
+            write_vtk(&json, &mut vtk_entries)?;
+        }
     }
     // The next step at which anything happens: an output, the settling check, or a
     // progress update. The engine runs freely in between (on the GPU: many steps per
@@ -236,8 +268,11 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
             ));
         }
         if snap_every.is_some_and(|k| step.is_multiple_of(k)) {
-            snapshot::write(engine.sim(), &snap_dir, &format!("snap_{step:010}"))
+            let json = snapshot::write(engine.sim(), &snap_dir, &format!("snap_{step:010}"))
                 .map_err(io(&snap_dir))?;
+            if o.vtk {
+                write_vtk(&json, &mut vtk_entries)?;
+            }
         }
         if ckpt_every.is_some_and(|k| step.is_multiple_of(k)) {
             write_checkpoint(engine.sim(), &ckpt_dir, &mut checkpoints)?;

@@ -359,3 +359,43 @@ fn grains_that_rolled_away_do_not_widen_the_heap() {
     );
     assert!((plain.repose_left.angle_deg - strays.repose_left.angle_deg).abs() < 1.0);
 }
+
+#[test]
+fn a_run_with_output_vtk_writes_a_paraview_time_series() {
+    let dir = tmp("vtk-run");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args([
+            "run",
+            "-q",
+            "--backend",
+            "cpu",
+            "--out",
+            dir.to_str().unwrap(),
+            "--set",
+            "output.vtk=true",
+            "--set",
+            "output.snapshot_every=1",
+            "--set",
+            "stop.time=3",
+            "--set",
+            "stop.kinetic_fraction=null",
+        ])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let pvd = std::fs::read_to_string(dir.join("snapshots/snapshots.pvd")).unwrap();
+    // Snapshots at t = 1, 2, 3 have grains (t = 0 is before the first one falls in).
+    let files: Vec<&str> = pvd
+        .lines()
+        .filter_map(|l| {
+            l.split("file=\"")
+                .nth(1)
+                .map(|f| &f[..f.find('"').unwrap()])
+        })
+        .collect();
+    assert!(files.len() >= 6 && files.len() % 2 == 0, "{pvd}");
+    for f in files {
+        let text = std::fs::read_to_string(dir.join("snapshots").join(f)).unwrap();
+        assert!(text.contains("<PolyData>"), "{f}");
+    }
+}

@@ -85,6 +85,24 @@ fn write_piece(path: &Path, p: &Piece) -> Result<(), String> {
 
 /// Writes `grains.vtp` and `contacts.vtp` into `dir`.
 pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
+    write_named(a, dir, "")
+}
+
+/// A ParaView collection of (time, grains file, contacts file), relative to its folder.
+pub fn collection(entries: &[(f64, String, String)]) -> String {
+    let mut s = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n",
+    );
+    for (t, g, c) in entries {
+        let _ = writeln!(s, r#"    <DataSet timestep="{t:e}" part="0" file="{g}"/>"#);
+        let _ = writeln!(s, r#"    <DataSet timestep="{t:e}" part="1" file="{c}"/>"#);
+    }
+    s.push_str("  </Collection>\n</VTKFile>\n");
+    s
+}
+
+/// Writes `{prefix}grains.vtp` and `{prefix}contacts.vtp` into `dir`.
+pub fn write_named(a: &Analysis, dir: &Path, prefix: &str) -> Result<Vec<PathBuf>, String> {
     let grains = &a.input.grains;
     let mut points = Vec::new();
     let mut cells = Vec::new();
@@ -173,7 +191,7 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
         ],
     };
     let mut files = Vec::new();
-    let p = dir.join("grains.vtp");
+    let p = dir.join(format!("{prefix}grains.vtp"));
     write_piece(&p, &piece)?;
     files.push(p);
     // Contacts: lines from centre to centre, or to the contact point on a wall.
@@ -203,7 +221,7 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
             ("wall".into(), "UInt8", wall),
         ],
     };
-    let p = dir.join("contacts.vtp");
+    let p = dir.join(format!("{prefix}contacts.vtp"));
     write_piece(&p, &piece)?;
     files.push(p);
     Ok(files)

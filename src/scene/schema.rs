@@ -461,6 +461,10 @@ pub struct Output {
     /// Interval of the energy log (log.csv).
     #[serde(default)]
     pub log_every: f64,
+    /// Also write each snapshot as VTK PolyData for ParaView (grains and contacts, with
+    /// `snapshots.pvd` listing them in time).
+    #[serde(default)]
+    pub vtk: bool,
 }
 
 impl Default for Output {
@@ -469,6 +473,7 @@ impl Default for Output {
             snapshot_every: 0.0,
             checkpoint_every: None,
             log_every: 0.0,
+            vtk: false,
         }
     }
 }
