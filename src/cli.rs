@@ -111,11 +111,14 @@ enum Command {
     /// Run one of the papers' scenes (R1–R8; reduced unless --full), then
     /// measure and draw it; writes reproduce.json with the numbers it is judged by.
     Reproduce {
-        /// R1 to R8 (R7 only with --full).
+        /// R1 to R8.
         id: String,
         /// The paper's size instead of the reduced form.
         #[arg(long)]
         full: bool,
+        /// Only the variants whose name contains this (e.g. `wedge-poly`, `seed3`).
+        #[arg(long)]
+        only: Option<String>,
         /// Output folder (default: runs/reproduce/ID).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -202,10 +205,11 @@ pub fn main() -> ExitCode {
         Command::Reproduce {
             id,
             full,
+            only,
             out,
             backend,
             quiet,
-        } => cmd_reproduce(&id, full, out, backend, quiet),
+        } => cmd_reproduce(&id, full, only.as_deref(), out, backend, quiet),
         Command::Bench {
             backend,
             sizes,
@@ -377,13 +381,24 @@ fn cmd_render(
 fn cmd_reproduce(
     id: &str,
     full: bool,
+    only: Option<&str>,
     out: Option<PathBuf>,
     backend: Backend,
     quiet: bool,
 ) -> Result<(), Failure> {
     use talus::reproduce;
     let id = id.to_uppercase();
-    let variants = reproduce::variants(&id, full).map_err(bad_input)?;
+    let mut variants = reproduce::variants(&id, full).map_err(bad_input)?;
+    if let Some(only) = only {
+        let names: Vec<String> = variants.iter().map(|v| v.name.clone()).collect();
+        variants.retain(|v| v.name.contains(only));
+        if variants.is_empty() {
+            return Err(bad_input(format!(
+                "--only {only}: no variant of {id} matches; they are {}",
+                names.join(", ")
+            )));
+        }
+    }
     let root = out.unwrap_or_else(|| PathBuf::from("runs/reproduce").join(&id));
     let mut found = Vec::new();
     let mut failed = Vec::new();

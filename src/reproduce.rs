@@ -29,6 +29,8 @@ const R7_MEDIUM: &str = include_str!("../scenes/r7_wedge_medium.json");
 const R7_POLY: &str = include_str!("../scenes/r7_wedge_poly.json");
 const R7_LAYERED: &str = include_str!("../scenes/r7_layered_medium.json");
 const R8: &str = include_str!("../scenes/r8_polygon_pile.json");
+/// Grains per second of the R7 wedge sources (one every 0.075 s, as in R6).
+const R7_RATE: f64 = 40.0 / 3.0;
 const R8_REDUCED: &str = include_str!("../scenes/r8_polygon_pile_reduced.json");
 
 /// What R1–R9 reproduce (SPEC 6), in one line each.
@@ -66,7 +68,7 @@ fn v(name: &str, scene: &'static str, overrides: &[&str], window: f64, row: f64)
     }
 }
 
-/// The runs of reproduction `id` (R1, R4, R6, R7, R8).
+/// The runs of reproduction `id` (R1–R8).
 pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
     let r7 = |name: &str, scene: &'static str| v(name, scene, &[], 14.0, 2.0);
     let lattice = |name: &str, set: Vec<String>| {
@@ -84,15 +86,13 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
         "R1" => vec![lattice("pile", Vec::new())],
         // R2 and R3: the R1 pile (frictionless, fixed bumpy bottom), its bottom row
         // squeezed or stretched by c, or with size disorder r_d over several seeds. The
-        // lattice is built with the bottom row's spacing and the drawn sizes, so squeezed
-        // rows and larger grains start overlapping by up to |c| d or r_d d/2; at R1's
-        // k_n = 1e7 N/m that is thousands of weights and the pile explodes (tried).
-        // R2 uses k_n = 1e5 N/m: the squeeze of c = −1/150 is then a few tens of weights
-        // (two grains fly off, the rest settles), and the dip appears; at 1e4 the squeeze
-        // is too weak to arch, at 1e6 the pile loses a third of its grains (tried). R3
-        // uses 1e4 N/m, which keeps r_d = 1/30 piles together and puts
-        // ϱ = r_d k_n/(σ d) (paper 000 sec. 4.4) below 1 for r_d = 2/3000 and above
-        // for r_d = 1/30, the paper's two regimes.
+        // lattice builder starts them without overlaps, as the paper does
+        // (src/create/lattice.rs). R2 is the paper's size at once: L1 = 19 mobile disks
+        // in row 1, 22 at the bottom. It runs at k_n = 1e5 N/m, where the overlaps
+        // under gravity (1–3 µm, measured) are comparable to the squeeze of c = −1/750
+        // (|c| d0 = 2 µm) and smaller than that of −1/150: the dip then deepens with |c|
+        // as in the paper. At 1e6 and 1e7 N/m both squeezes jam the row fully and give
+        // the same dip, 28–29 % (tried).
         "R2" => [
             ("1_15", 1.0 / 15.0),
             ("0", 0.0),
@@ -101,19 +101,26 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
         ]
         .iter()
         .map(|(name, c)| {
-            let bottom = if full { 98 } else { 20 };
-            lattice(
+            v(
                 &format!("c={name}"),
-                vec![
-                    format!("particles[0].spacing_c={c}"),
-                    format!("particles[0].bottom_row={bottom}"),
-                    "contact.k_n=1e5".into(),
+                R1_REDUCED,
+                &[
+                    &format!("particles[0].spacing_c={c}"),
+                    "particles[0].bottom_row=22",
+                    "contact.k_n=1e5",
                 ],
+                6.0,
+                LATTICE_ROW,
             )
         })
         .collect(),
         "R3" => {
-            let seeds = if full { 20 } else { 5 };
+            let seeds = if full { 10 } else { 5 };
+            // ϱ = r_d k_n/(σ d) = r_d d/δ (paper 000 sec. 4.4): these stiffnesses give
+            // the same overlaps in both piles, δ ≈ 5e-4 d on average and 1.5e-3 d at
+            // most (measured), so ϱ ≈ 0.5–1 for r_d = 2/3000 and 20–70 for r_d = 1/30:
+            // the paper's two regimes. (At R1's 1e7 N/m both are ϱ ≫ 1.)
+            let k_n = if full { 3e5 } else { 1e5 };
             let mut out = Vec::new();
             for (name, rd) in [("rd=2_3000", 2.0 / 3000.0), ("rd=1_30", 1.0 / 30.0)] {
                 for seed in 1..=seeds {
@@ -122,7 +129,7 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
                         vec![
                             format!("particles[0].size_disorder={rd}"),
                             format!("seed={seed}"),
-                            "contact.k_n=1e4".into(),
+                            format!("contact.k_n={k_n}"),
                         ],
                     ));
                 }
@@ -152,17 +159,19 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
                 ),
                 // The short tail is four times as steep: a quarter of the step.
                 v("n144", base, &["contact.n=144", "dt=0.00025"], 14.0, 1.0),
+                // δ % polydispersity: diameters uniform in [(1 − δ) σ, σ] (paper 001
+                // sec. II).
                 v(
                     "poly5",
                     base,
-                    &["particles[1].diameter={\"uniform\":[0.95,1.05]}"],
+                    &["particles[1].diameter={\"uniform\":[0.95,1.0]}"],
                     14.0,
                     1.0,
                 ),
                 v(
                     "poly10",
                     base,
-                    &["particles[1].diameter={\"uniform\":[0.9,1.1]}"],
+                    &["particles[1].diameter={\"uniform\":[0.9,1.0]}"],
                     14.0,
                     1.0,
                 ),
@@ -175,12 +184,33 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
             14.0,
             2.0,
         )],
+        // R7 reduced: about 30 % of the paper's grains, from the same source. (With
+        // 10 % the wedge heaps spread into a layer a few grains high, tried.) Each pour
+        // stops 15 s after its last grain, and not before 2 s after it; the layered pile
+        // is √0.3 as wide, for 30 % of the grains. Tens of minutes each on a 2-core CPU.
         "R7" if !full => {
-            return Err(
-                "R7 has no reduced form: with a tenth of the grains the wedge heaps spread \
-                        into a layer a few grains high (tried); run `talus reproduce R7 --full`"
-                    .into(),
-            );
+            let wedge = |name: &str, scene: &'static str, count: u32| {
+                let pour = count as f64 / R7_RATE;
+                let mut x = r7(name, scene);
+                x.overrides = vec![
+                    format!("particles[0].count={count}"),
+                    format!("stop.time={}", pour + 15.0),
+                    format!("stop.not_before={}", pour + 2.0),
+                ];
+                x
+            };
+            let mut layered = r7("layered-medium", R7_LAYERED);
+            layered.overrides = vec![
+                "particles[0].base_width=0.38".into(),
+                "stop.time=35".into(),
+                "stop.not_before=27".into(),
+            ];
+            vec![
+                wedge("wedge-mono", R7_MONO, 800),
+                wedge("wedge-medium", R7_MEDIUM, 1200),
+                wedge("wedge-poly", R7_POLY, 600),
+                layered,
+            ]
         }
         "R7" => vec![
             r7("wedge-mono", R7_MONO),

@@ -315,6 +315,48 @@ fn reproduce_r1_gives_the_papers_stress_ratio_of_one_third() {
 }
 
 #[test]
+fn reproduce_r2_dips_under_a_squeezed_bottom_only() {
+    // R2 (paper 000 sec. 4.1, Fig. 3a), L1 = 19: the pile starts without overlaps and
+    // S_zz(1) under the apex is the maximum for c = 0 (a hump), flat for c = −1/750, and
+    // a dip of well over 10 % for c = −1/150.
+    let dir = tmp("reproduce-r2");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args(["reproduce", "R2", "--backend", "cpu", "-q", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("reproduce.json")).unwrap())
+            .unwrap();
+    let variant = |name: &str| {
+        report["variants"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|v| v["variant"] == name)
+            .unwrap_or_else(|| panic!("no variant {name}"))
+            .clone()
+    };
+    let (flat, light, strong) = (variant("c=0"), variant("c=-1_750"), variant("c=-1_150"));
+    for v in [&flat, &light, &strong] {
+        assert_eq!(v["grains"], 92, "no grain is lost: {v}");
+    }
+    let f = |v: &serde_json::Value, k: &str| v[k].as_f64().unwrap();
+    assert_eq!(
+        f(&flat, "row1_dip"),
+        0.0,
+        "c = 0 has its maximum under the apex"
+    );
+    assert!(f(&strong, "row1_dip") > 0.15, "c = −1/150: {strong}");
+    assert!(
+        f(&flat, "row1_szz_centre") > f(&light, "row1_szz_centre")
+            && f(&light, "row1_szz_centre") > f(&strong, "row1_szz_centre"),
+        "S_zz(1) under the apex falls with the squeeze"
+    );
+}
+
+#[test]
 fn stresses_average_over_snapshots() {
     // The same column twice, once with every contact force tripled: the averaged
     // stress tables are twice the single one; everything else is the last snapshot's.

@@ -266,3 +266,11 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
         "{err}"
     );
 }
+
+#[test]
+fn reproduce_only_names_the_variants_when_none_matches() {
+    assert_rejected(
+        &["reproduce", "R2", "--only", "c=2"],
+        &["--only c=2", "c=1_15", "c=-1_150"],
+    );
+}
