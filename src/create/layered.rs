@@ -59,7 +59,9 @@ pub fn emit(
     particles: &Particles,
 ) -> Vec<NewParticle> {
     let k = state.inserted;
-    if k >= row_count(spec) || t < spec.start_time + k as f64 * spec.interval {
+    // Time first: `row_count` samples the polygon family for its reach (milliseconds),
+    // and this runs every step.
+    if t < spec.start_time + k as f64 * spec.interval || k >= row_count(spec) {
         return Vec::new();
     }
     let d = largest(spec);

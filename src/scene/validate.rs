@@ -4,6 +4,7 @@
 
 use super::{ContactSpec, Creation, PolygonSpec, Scene, SceneError, Size};
 use crate::law::ContactLaw;
+use std::sync::Mutex;
 
 /// A contact must last at least this many steps; beyond t_c/10 only a warning (SPEC 3).
 pub const MIN_STEPS_PER_CONTACT: f64 = 5.0;
@@ -97,6 +98,20 @@ pub fn reach_bound_of(diameter: Option<&Size>, polygon: Option<&PolygonSpec>) ->
         return drawn_size_bounds(diameter, polygon).1;
     };
     let (a, b) = (a.bounds(), b.bounds());
+    // Sampling takes about a millisecond and layered blocks ask every step: remember
+    // each polygon family's bound.
+    static KNOWN: Mutex<Vec<([u64; 5], f64)>> = Mutex::new(Vec::new());
+    let key = [
+        p.corners as u64,
+        a.0.to_bits(),
+        a.1.to_bits(),
+        b.0.to_bits(),
+        b.1.to_bits(),
+    ];
+    let mut known = KNOWN.lock().unwrap_or_else(|e| e.into_inner());
+    if let Some(&(_, reach)) = known.iter().find(|(k, _)| *k == key) {
+        return reach;
+    }
     let mut reach: f64 = 0.0;
     for (x, z) in [(a.0, b.0), (a.0, b.1), (a.1, b.0), (a.1, b.1)] {
         for k in 0..256 {
@@ -105,6 +120,7 @@ pub fn reach_bound_of(diameter: Option<&Size>, polygon: Option<&PolygonSpec>) ->
             reach = reach.max(2.0 * crate::shape::circumradius(&v));
         }
     }
+    known.push((key, 1.02 * reach));
     1.02 * reach
 }
 
