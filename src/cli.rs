@@ -463,6 +463,35 @@ fn cmd_reproduce(
         found.push(f);
     }
     let averages = reproduce::seed_averages(&found);
+    // Row-1 profiles side by side: the seed averages where there are seeds.
+    let profiles: Vec<(String, Vec<(f64, f64)>)> = if averages.is_empty() {
+        found
+            .iter()
+            .map(|f| (f.variant.clone(), f.row1_profile.clone()))
+            .collect()
+    } else {
+        averages
+            .iter()
+            .map(|a| {
+                (
+                    format!("{} ({} seeds)", a.setting, a.seeds),
+                    a.profile.clone(),
+                )
+            })
+            .collect()
+    };
+    if !profiles.is_empty() {
+        let path = root.join("profiles.svg");
+        talus::render::plots::write_profiles(
+            &path,
+            &format!("{id}: vertical stress in row 1"),
+            &profiles,
+        )
+        .map_err(|e| Failure {
+            code: 1,
+            message: e,
+        })?;
+    }
     for a in &averages {
         out!(
             "{id} {} (average of {} seeds): S_zz(1) under the apex {:.3}, max {:.3}, dip {:.2}; Z interior {:.2}",

@@ -339,6 +339,11 @@ fn reproduce_r2_dips_under_a_squeezed_bottom_only() {
             .clone()
     };
     let (flat, light, strong) = (variant("c=0"), variant("c=-1_750"), variant("c=-1_150"));
+    // The four profiles are drawn side by side, one line and legend entry each.
+    let svg = std::fs::read_to_string(dir.join("profiles.svg")).unwrap();
+    for name in ["c=1_15", "c=0", "c=-1_750", "c=-1_150"] {
+        assert!(svg.contains(&format!("\n{name}\n")), "legend {name}");
+    }
     for v in [&flat, &light, &strong] {
         assert_eq!(v["grains"], 92, "no grain is lost: {v}");
     }

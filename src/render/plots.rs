@@ -133,3 +133,34 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
     }
     Ok(files)
 }
+
+/// Row-1 profiles S_zz(X − X_apex) of several runs in one plot, as the papers compare
+/// them (paper 000 Fig. 3a, 8, 10): one line per variant, or per seed average.
+pub fn write_profiles(
+    path: &Path,
+    title: &str,
+    profiles: &[(String, Vec<(f64, f64)>)],
+) -> Result<(), String> {
+    const PALETTE: [RGBColor; 8] = [
+        BLUE,
+        RED,
+        RGBColor(0, 140, 0),
+        MAGENTA,
+        BLACK,
+        RGBColor(230, 140, 0),
+        CYAN,
+        RGBColor(120, 120, 120),
+    ];
+    let series: Vec<Series> = profiles
+        .iter()
+        .enumerate()
+        .map(|(k, (name, data))| (name.as_str(), PALETTE[k % PALETTE.len()], data.clone()))
+        .collect();
+    plot(
+        path,
+        title,
+        "X - X_apex",
+        "S_zz(1) = 2 sigma_zz / (rho g h)",
+        &series,
+    )
+}
