@@ -119,6 +119,10 @@ enum Command {
         /// Only the variants whose name contains this (e.g. `wedge-poly`, `seed3`).
         #[arg(long)]
         only: Option<String>,
+        /// Keep the variants whose folder already holds a finished run of the same
+        /// scene: measure and draw them again without running them.
+        #[arg(long)]
+        reuse: bool,
         /// Output folder (default: runs/reproduce/ID).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -206,10 +210,11 @@ pub fn main() -> ExitCode {
             id,
             full,
             only,
+            reuse,
             out,
             backend,
             quiet,
-        } => cmd_reproduce(&id, full, only.as_deref(), out, backend, quiet),
+        } => cmd_reproduce(&id, full, only.as_deref(), reuse, out, backend, quiet),
         Command::Bench {
             backend,
             sizes,
@@ -378,10 +383,21 @@ fn cmd_render(
     Ok(())
 }
 
+/// Whether `dir` holds a finished run (its `summary.json` is written last) of exactly
+/// `scene`.
+fn finished_run_of(dir: &std::path::Path, scene: &scene::Scene) -> bool {
+    let read = |name: &str| -> Option<serde_json::Value> {
+        serde_json::from_str(&std::fs::read_to_string(dir.join(name)).ok()?).ok()
+    };
+    read("summary.json").is_some()
+        && read("scene.json").is_some_and(|s| serde_json::to_value(scene).ok() == Some(s))
+}
+
 fn cmd_reproduce(
     id: &str,
     full: bool,
     only: Option<&str>,
+    reuse: bool,
     out: Option<PathBuf>,
     backend: Backend,
     quiet: bool,
@@ -407,18 +423,30 @@ fn cmd_reproduce(
             .map_err(|e| bad_input(format!("{id} {}: {e}", v.name)))?;
         let sim = Simulation::new(scene).map_err(|e| bad_input(format!("{id} {}: {e}", v.name)))?;
         let dir = root.join(&v.name);
+        let finished = reuse && finished_run_of(&dir, &sim.scene);
         if !quiet {
-            eprintln!("{id} {}: {} -> {}", v.name, sim.scene.name, dir.display());
+            let how = if finished {
+                " (finished run reused)"
+            } else {
+                ""
+            };
+            eprintln!(
+                "{id} {}: {} -> {}{how}",
+                v.name,
+                sim.scene.name,
+                dir.display()
+            );
         }
-        let mut engine = choose_engine(sim, backend, quiet)?;
-        // A variant that fails is reported and the others still run.
-        if let Err(e) = run::run(
-            &mut engine,
+        if finished {
+            // Measured and drawn below like a fresh run.
+        } else if let Err(e) = run::run(
+            &mut choose_engine(sim, backend, quiet)?,
             &run::RunOptions {
                 out: dir.clone(),
                 quiet,
             },
         ) {
+            // A variant that fails is reported and the others still run.
             eprintln!("error: {id} {}: {e}", v.name);
             failed.push(serde_json::json!({ "variant": v.name, "error": e.to_string() }));
             continue;

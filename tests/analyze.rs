@@ -359,6 +359,35 @@ fn reproduce_r2_dips_under_a_squeezed_bottom_only() {
             && f(&light, "row1_szz_centre") > f(&strong, "row1_szz_centre"),
         "S_zz(1) under the apex falls with the squeeze"
     );
+    // --reuse measures a finished run again without running it; --only picks it.
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args([
+            "reproduce",
+            "R2",
+            "--backend",
+            "cpu",
+            "--reuse",
+            "--only",
+            "c=0",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success() && err.contains("(finished run reused)"),
+        "{err}"
+    );
+    assert!(!err.contains("step "), "no steps are run again: {err}");
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("reproduce.json")).unwrap())
+            .unwrap();
+    assert_eq!(again["variants"].as_array().unwrap().len(), 1);
+    assert_eq!(
+        again["variants"][0]["row1_szz_centre"],
+        flat["row1_szz_centre"]
+    );
 }
 
 #[test]
