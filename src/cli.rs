@@ -85,6 +85,11 @@ enum Command {
         /// the final state); needs a run folder.
         #[arg(long)]
         from: Option<f64>,
+        /// The angle of repose is fitted to the free surface between these fractions of
+        /// the height (leaving out toe and apex); raise the lower one for a heap on a
+        /// wide layer.
+        #[arg(long, num_args = 2, value_names = ["FROM", "TO"], default_values_t = [0.15, 0.85])]
+        fit: Vec<f64>,
     },
     /// Pictures of a snapshot (or a run folder's final state) in PNG and SVG: grains
     /// coloured by a field, the force network, principal-stress crosses, profile plots;
@@ -197,7 +202,8 @@ pub fn main() -> ExitCode {
             row,
             g,
             from,
-        } => cmd_analyze(&path, out, window, step, row, g, from),
+            fit,
+        } => cmd_analyze(&path, out, window, step, row, g, from, [fit[0], fit[1]]),
         Command::Render {
             path,
             out,
@@ -270,8 +276,15 @@ fn cmd_analyze(
     row: f64,
     g: Option<f64>,
     from: Option<f64>,
+    fit: [f64; 2],
 ) -> Result<(), Failure> {
     use talus::analyze;
+    if !(0.0 <= fit[0] && fit[0] < fit[1] && fit[1] <= 1.0) {
+        return Err(bad_input(format!(
+            "--fit {} {}: needs 0 <= FROM < TO <= 1 (fractions of the heap's height)",
+            fit[0], fit[1]
+        )));
+    }
     for (name, v) in [("--window", window), ("--step", step), ("--row", row)] {
         if !(v.is_finite() && v > 0.0) {
             return Err(bad_input(format!(
@@ -288,6 +301,8 @@ fn cmd_analyze(
         window,
         step,
         row,
+        fit_from: fit[0],
+        fit_to: fit[1],
         ..Default::default()
     };
     let mut earlier = Vec::new();

@@ -274,3 +274,11 @@ fn reproduce_only_names_the_variants_when_none_matches() {
         &["--only c=2", "c=1_15", "c=-1_150"],
     );
 }
+
+#[test]
+fn analyze_rejects_a_reversed_fit_range() {
+    assert_rejected(
+        &["analyze", "scenes/r1_pile.json", "--fit", "0.9", "0.2"],
+        &["--fit 0.9 0.2", "FROM < TO"],
+    );
+}
