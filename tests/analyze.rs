@@ -213,6 +213,22 @@ fn the_command_writes_its_tables_and_rejects_bad_input() {
     assert!(err.contains("--window"), "{err}");
 }
 
+/// The numbers of the VTK DataArray called `name` (ASCII format).
+fn data_array(xml: &str, name: &str) -> Vec<f64> {
+    let tag = format!("Name=\"{name}\"");
+    let at = xml
+        .find(&tag)
+        .unwrap_or_else(|| panic!("no DataArray {name}"));
+    let body = &xml[at..];
+    let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
+    body.split_whitespace()
+        .map(|v| {
+            v.parse()
+                .unwrap_or_else(|_| panic!("{name}: {v} is no number"))
+        })
+        .collect()
+}
+
 #[test]
 fn render_draws_pictures_and_vtk_files_of_the_column() {
     let s = settled_column();
@@ -260,17 +276,71 @@ fn render_draws_pictures_and_vtk_files_of_the_column() {
         (wmax / wmin - N as f64).abs() < 0.05 * N as f64,
         "widths ∝ force: {wmin} .. {wmax}"
     );
-    // VTK: N grains as polygons, N contacts as lines.
+    // The grains picture shows the grains: decoded, it is as tall as the outline with
+    // its margin, every grain's centre is painted, and the painted share of the picture
+    // is the grains' share of it (N π r² at the picture's scale).
+    let a = analyse(&s, &dir, 1.0);
+    let o = &a.summary.outline;
+    let pad = 0.04 * o.width.max(o.height);
+    let scale = 400.0 / (o.width + 2.0 * pad);
+    let png = tiny_skia::Pixmap::load_png(out.join("grains.png")).unwrap();
+    assert_eq!(png.width(), 400);
+    assert_eq!(png.height(), ((o.height + 2.0 * pad) * scale).ceil() as u32);
+    let white = |x: u32, y: u32| {
+        let p = png.pixel(x, y).unwrap();
+        p.red() > 250 && p.green() > 250 && p.blue() > 250
+    };
+    for g in &a.input.grains {
+        let x = ((g.x - (o.left - pad)) * scale) as u32;
+        let y = ((o.top + pad - g.z) * scale) as u32;
+        assert!(!white(x, y), "grain at ({}, {}) painted", g.x, g.z);
+    }
+    assert!(white(2, 2), "the margin stays white");
+    let painted = (0..png.height())
+        .flat_map(|y| (0..png.width()).map(move |x| (x, y)))
+        .filter(|&(x, y)| !white(x, y))
+        .count() as f64;
+    let grains_px = N as f64 * std::f64::consts::PI * (0.5 * scale).powi(2);
+    assert!(
+        (painted / grains_px - 1.0).abs() < 0.05,
+        "{painted} pixels painted against {grains_px} for the grains"
+    );
+    // VTK: read back, N grains as polygons around the grains' centres and N contacts
+    // as lines.
     let vtp = std::fs::read_to_string(out.join("grains.vtp")).unwrap();
     assert!(
         vtp.contains(&format!("NumberOfPolys=\"{N}\"")),
         "grains.vtp"
     );
+    let points = data_array(&vtp, "Points");
+    let offsets = data_array(&vtp, "offsets");
+    let connectivity = data_array(&vtp, "connectivity");
+    assert_eq!(offsets.len(), N, "one polygon per grain");
+    assert_eq!(*offsets.last().unwrap() as usize, connectivity.len());
+    let mut start = 0;
+    for (k, end) in offsets.iter().enumerate() {
+        let cell = &connectivity[start..*end as usize];
+        let (mut x, mut z) = (0.0, 0.0);
+        for &p in cell {
+            x += points[3 * p as usize] / cell.len() as f64;
+            z += points[3 * p as usize + 1] / cell.len() as f64;
+        }
+        let g = &a.input.grains[k];
+        assert!(
+            (x - g.x).abs() < 1e-9 && (z - g.z).abs() < 1e-9,
+            "polygon {k} around ({x}, {z}), grain at ({}, {})",
+            g.x,
+            g.z
+        );
+        start = *end as usize;
+    }
+    assert_eq!(data_array(&vtp, "id").len(), N, "one id per grain");
     let vtp = std::fs::read_to_string(out.join("contacts.vtp")).unwrap();
     assert!(
         vtp.contains(&format!("NumberOfLines=\"{N}\"")),
         "contacts.vtp"
     );
+    assert_eq!(data_array(&vtp, "offsets").len(), N, "one line per contact");
     for f in ["base_profile.svg", "force_distribution.svg"] {
         assert!(out.join(f).is_file(), "{f}");
     }
@@ -469,9 +539,283 @@ fn a_run_with_output_vtk_writes_a_paraview_time_series() {
                 .map(|f| &f[..f.find('"').unwrap()])
         })
         .collect();
-    assert!(files.len() >= 6 && files.len() % 2 == 0, "{pvd}");
+    assert!(files.len() >= 6 && files.len().is_multiple_of(2), "{pvd}");
     for f in files {
         let text = std::fs::read_to_string(dir.join("snapshots").join(f)).unwrap();
         assert!(text.contains("<PolyData>"), "{f}");
     }
+}
+
+/// Disks of diameter 1 listed at `centres`, as a scene list block.
+fn disks(centres: &[[f64; 2]]) -> serde_json::Value {
+    let list: Vec<_> = centres
+        .iter()
+        .map(|c| json!({ "position": c, "diameter": 1.0 }))
+        .collect();
+    json!({ "kind": "list", "material": "m", "particles": list })
+}
+
+#[test]
+fn a_compressed_triangular_packing_has_the_isotropic_stress_computed_by_hand() {
+    // A triangular lattice of unit disks at spacing s = 1 − δ, no gravity, linear springs:
+    // every interior contact pushes with f = k δ along the line of centres, at the
+    // contact point s/2 from each centre. Per grain, Σ_c f ⊗ l (compression positive) is
+    // f (s/2) Σ_c n ⊗ n = (3/2) f s I over its six neighbours, and the grain's Voronoi
+    // cell is (√3/2) s², so σ = √3 f / s · I (paper 000 eq. 8) with no shear.
+    let (delta, k) = (1e-3, 1e5);
+    let s = 1.0 - delta;
+    let h = 0.5 * 3f64.sqrt() * s;
+    let (rows, cols) = (21, 40);
+    let mut centres = Vec::new();
+    for j in 0..rows {
+        for i in 0..cols {
+            centres.push([i as f64 * s + 0.5 * s * (j % 2) as f64, j as f64 * h]);
+        }
+    }
+    let law = json!({ "law": "spring_dashpot", "k_n": k, "gamma_n": 10.0, "k_t": 2e4, "gamma_t": 1.0, "mu": 0.5 });
+    let mut sim = sim(&scene_value(law, json!([disks(&centres)])));
+    // One step evaluates the contacts. Gear starts from the true accelerations, so only
+    // the outermost grains (whose forces do not balance) move in it.
+    sim.step().unwrap();
+    let f = k * delta;
+    // Rows one lattice row high from the lowest bottom (each holds one lattice row), and
+    // windows 8 spacings wide, so that a window holds 8 grains of each row it covers:
+    // its edges never meet a centre (the left end is at −1/2, and 1/2 is no multiple of
+    // s/4).
+    let opt = Options {
+        row: h,
+        window: 8.0 * s,
+        step: 0.25 * s,
+        ..Default::default()
+    };
+    let a = analyse_with(&sim, &tmp("lattice-compressed"), 1.0, &opt);
+    let by_hand = 3f64.sqrt() * f / s;
+    let x_max = (cols - 1) as f64 * s + 0.5 * s;
+    let mut checked = 0;
+    for w in &a.windows {
+        // Interior: two grains' spacing from every edge of the patch.
+        let inside = w.row >= 2
+            && w.row + 3 <= rows
+            && w.x - 4.0 * s >= 2.0 * s
+            && w.x + 4.0 * s <= x_max - 2.0 * s;
+        if !inside {
+            continue;
+        }
+        assert_eq!(w.particles, 8, "window at x = {}, row {}", w.x, w.row);
+        let t = w.sigma;
+        assert!(
+            (t.xx / by_hand - 1.0).abs() < 1e-9 && (t.zz / by_hand - 1.0).abs() < 1e-9,
+            "window at x = {}, row {}: σ_xx = {}, σ_zz = {} against {by_hand}",
+            w.x,
+            w.row,
+            t.xx,
+            t.zz
+        );
+        assert!(
+            t.xz.abs() < 1e-9 * by_hand && t.zx.abs() < 1e-9 * by_hand,
+            "no shear: {t:?}"
+        );
+        let (s1, s2, _) = t.principal();
+        assert!((s1 - s2).abs() < 1e-9 * by_hand, "isotropic: {s1} {s2}");
+        checked += 1;
+    }
+    assert!(checked > 100, "{checked} interior windows");
+    // Grain by grain: an interior grain carries (3/2) f s in xx and zz.
+    let middle = (rows / 2) * cols + cols / 2;
+    let m = a.moments[middle];
+    assert!((m.xx / (1.5 * f * s) - 1.0).abs() < 1e-9, "{m:?}");
+    assert!((m.zz / (1.5 * f * s) - 1.0).abs() < 1e-9, "{m:?}");
+    assert_eq!(a.counts[middle], 6);
+}
+
+/// A 30° pile of `base` unit disks (m = 1) on a triangular lattice standing on a floor
+/// at z = 0, with friction, settled under g = 1.
+fn settled_pile_on_a_floor(base: usize) -> talus::sim::Simulation {
+    let h = 0.5 * 3f64.sqrt();
+    let mut centres = Vec::new();
+    for j in 0..base {
+        for i in 0..base - j {
+            centres.push([i as f64 + 0.5 * j as f64, 0.5 + j as f64 * h]);
+        }
+    }
+    let law = json!({ "law": "spring_dashpot", "k_n": 1e5, "gamma_n": 150.0, "k_t": 2e4, "gamma_t": 15.0, "mu": 0.5 });
+    // Round grains on a flat floor roll apart under the pile's outward thrust; these
+    // do not turn, so friction holds the pile.
+    let mut block = disks(&centres);
+    for p in block["particles"].as_array_mut().unwrap() {
+        p["fixed_rotation"] = json!(true);
+    }
+    let mut v = scene_value(law, json!([block]));
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-10.0, 0.0], "to": [base as f64 + 10.0, 0.0] }]);
+    let mut s = sim(&v);
+    for _ in 0..60_000 {
+        s.step().unwrap();
+    }
+    s
+}
+
+#[test]
+fn the_stress_at_the_base_integrates_to_the_weight_of_the_pile() {
+    // A settled pile of 136 disks on a flat floor. Windows that tile the row (width =
+    // step = 0.7 d, whose edges never meet a lattice column) count every grain once.
+    let base = 16;
+    let s = settled_pile_on_a_floor(base);
+    let h = 0.5 * 3f64.sqrt();
+    let (r, dz) = (0.5, 0.5 + 0.5 * h);
+    let opt = Options {
+        row: dz,
+        window: 0.7,
+        step: 0.7,
+        ..Default::default()
+    };
+    let a = analyse_with(&s, &tmp("pile-on-floor"), 1.0, &opt);
+    let grains = &a.input.grains;
+    let weight: f64 = grains.iter().map(|g| g.mass).sum();
+    let ke = s.energies();
+    assert!(
+        ke.kinetic() < 1e-5 * ke.elastic,
+        "settled: {} against {}",
+        ke.kinetic(),
+        ke.elastic
+    );
+    // The floor's pressure profile carries the whole weight.
+    let on_floor: f64 = a.wall_pressure.iter().map(|p| p.1 * opt.step).sum();
+    assert!(
+        (on_floor / weight - 1.0).abs() < 2e-3,
+        "floor carries {on_floor} of {weight}"
+    );
+    // The lowest row, from the floor up to the contacts with the second lattice row
+    // (dz = r + h/2), holds the grains that stand on the floor. Its coarse-grained σ_zz,
+    // integrated along x, is the vertical force through the row averaged over its height:
+    // the whole weight from the floor up to the centres at r, and the weight of the rows
+    // above from there on, W − W_0 (1 − r/dz).
+    let row0: Vec<_> = a.windows.iter().filter(|w| w.row == 0).collect();
+    let integral: f64 = row0.iter().map(|w| w.sigma.zz * opt.step).sum();
+    let counted: usize = row0.iter().map(|w| w.particles).sum();
+    assert_eq!(counted, base, "each grain of the bottom row counted once");
+    let w0 = base as f64 * grains[0].mass;
+    let carried = weight - w0 * (1.0 - r / dz);
+    assert!(
+        (integral / carried - 1.0).abs() < 2e-3,
+        "∫σ_zz dx = {integral} against {carried} (W = {weight})"
+    );
+}
+
+#[test]
+fn the_slopes_of_a_synthetic_heap_are_recovered() {
+    // A heap 40 d high built to known slopes, 26° on the left and 34° on the right:
+    // its surface a layer of unit disks along each slope (one diameter apart along it,
+    // their tops on the line), its inside a triangular lattice kept below that layer.
+    let (height, left, right) = (40.0, 26f64.to_radians(), 34f64.to_radians());
+    let line = |x: f64| {
+        if x < 0.0 {
+            height + x * left.tan()
+        } else {
+            height - x * right.tan()
+        }
+    };
+    let mut centres = Vec::new();
+    for (angle, side) in [(left, -1.0), (right, 1.0)] {
+        let toe = (height - 1.0) / angle.tan();
+        let n = (toe / angle.cos()).floor() as usize;
+        for m in 0..=n {
+            let x = side * (toe - m as f64 * angle.cos());
+            centres.push([x, line(x) - 0.5]);
+        }
+    }
+    let h = 0.5 * 3f64.sqrt();
+    for j in 0.. {
+        let z = 0.5 + j as f64 * h;
+        if z > height {
+            break;
+        }
+        for i in -200..200 {
+            let x = i as f64 + 0.5 * (j % 2) as f64;
+            if z + 0.5 <= line(x) - 0.8 {
+                centres.push([x, z]);
+            }
+        }
+    }
+    let law = json!({ "law": "spring_dashpot", "k_n": 1e5, "gamma_n": 10.0, "k_t": 2e4, "gamma_t": 1.0, "mu": 0.5 });
+    let mut v = scene_value(law, json!([disks(&centres)]));
+    v["domain"] = json!({ "x": [-200.0, 200.0], "z": [-10.0, 100.0] });
+    let s = sim(&v);
+    let a = analyse(&s, &tmp("synthetic-heap"), 1.0);
+    let sm = &a.summary;
+    assert!((sm.outline.height - height).abs() < 0.6, "{:?}", sm.outline);
+    for (slope, want) in [(&sm.repose_left, 26.0), (&sm.repose_right, 34.0)] {
+        assert!(slope.points >= 30, "{} points fitted", slope.points);
+        assert!(
+            (slope.angle_deg - want).abs() < 0.5,
+            "{} against {want}°",
+            slope.angle_deg
+        );
+        assert!(slope.residual < 0.5, "RMS residual {}", slope.residual);
+    }
+}
+
+#[test]
+fn parallel_and_perpendicular_pairs_give_the_known_orientation_statistics() {
+    // Pairs of elongated octagons (axes 2 : 1, symmetric, so the long axis is exactly the
+    // body's x axis) far apart from each other (more than Q's reach of 10 d). Twelve
+    // pairs 3 apart are parallel, both turned by 0.4; twelve 6 apart are perpendicular,
+    // turned by 1.0 and 1.0 + π/2. Then Q = cos 2(θ_i − θ_j) is +1 at r = 3 and −1 at
+    // r = 6, and f(θ) holds 1/2 of the grains at 0.4 and 1/4 each at 1.0 and 1.0 + π/2.
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    let mut list = Vec::new();
+    for p in 0..24 {
+        let (cx, cz) = (-75.0 + 30.0 * (p % 6) as f64, -60.0 + 30.0 * (p / 6) as f64);
+        let (gap, a, b) = if p % 2 == 0 {
+            (3.0, 0.4, 0.4)
+        } else {
+            (6.0, 1.0, 1.0 + half_pi)
+        };
+        list.push(json!({ "position": [cx, cz], "theta": a, "diameter": 2.0 }));
+        list.push(json!({ "position": [cx + gap, cz], "theta": b, "diameter": 2.0 }));
+    }
+    let law = json!({ "law": "overlap_area", "k_n": 2000.0, "eta_n": 0.5, "mu": 0.5 });
+    let block =
+        json!({ "kind": "list", "material": "m", "particles": list, "polygon": { "corners": 8 } });
+    let mut s = sim(&scene_value(law, json!([block])));
+    let body = talus::shape::ellipse_polygon(8, 2.0, 1.0, 0.0);
+    s.particles.shape.iter_mut().for_each(|c| *c = body.clone());
+    let a = analyse(&s, &tmp("pairs"), 1.0);
+    assert_eq!(a.summary.oriented_grains, 48);
+    for g in a.axes.iter().zip(&a.input.grains) {
+        let want = if (g.1.theta - 0.4).abs() < 1e-12 {
+            0.4
+        } else {
+            g.1.theta
+        };
+        assert!((g.0.unwrap() - want).abs() < 1e-9, "long axis {:?}", g.0);
+    }
+    let d = a.summary.mean_diameter;
+    assert!(a.correlation.len() == 2, "{:?}", a.correlation);
+    for (r, q, pairs) in &a.correlation {
+        assert_eq!(*pairs, 12);
+        let (gap, want) = if (r - 3.0).abs() < 0.5 * d {
+            (3.0, 1.0)
+        } else {
+            (6.0, -1.0)
+        };
+        assert!(
+            (r - gap).abs() <= 0.25 * d,
+            "bin at {r} for pairs {gap} apart"
+        );
+        assert!((q - want).abs() < 1e-12, "Q({r}) = {q}, want {want}");
+    }
+    let width = std::f64::consts::PI / 18.0;
+    let weight_at = |theta: f64| {
+        a.orientation
+            .iter()
+            .find(|b| (b.0 - theta).abs() <= 0.5 * width)
+            .map(|b| b.1 * width)
+            .unwrap()
+    };
+    assert!((weight_at(0.4) - 0.5).abs() < 1e-12);
+    assert!((weight_at(1.0) - 0.25).abs() < 1e-12);
+    assert!((weight_at(1.0 + half_pi) - 0.25).abs() < 1e-12);
+    let total: f64 = a.orientation.iter().map(|b| b.1 * width).sum();
+    assert!((total - 1.0).abs() < 1e-12, "∫f = {total}");
 }
