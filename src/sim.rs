@@ -175,7 +175,7 @@ impl Simulation {
             && layered
                 .iter()
                 .zip(&self.sources[p..])
-                .all(|(spec, st)| st.inserted >= create::layered::row_count(spec))
+                .all(|(spec, st)| st.inserted >= create::layered::max_rows(spec))
             && self.time() >= self.scene.gravity.ramp_time
     }
 

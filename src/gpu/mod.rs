@@ -229,16 +229,16 @@ impl GpuSimulation {
                 state: st.clone(),
             });
         }
-        // Layered rows still to come: their sizes are fixed by the outline, so the
-        // buffers are sized for them now (their corners go after the candidates').
+        // Layered rows still to come: the buffers are sized now for the most they can
+        // hold (their corners go after the candidates').
         let mut layered = Vec::new();
         let mut layered_count = 0u32;
         let mut layered_corners = 0usize;
         for (m, spec) in layered_specs.iter().enumerate() {
             let index = specs.len() + m;
             let corners = spec.polygon.as_ref().map_or(0, |p| p.corners as usize);
-            for k in sim.sources[index].inserted..create::layered::row_count(spec) {
-                let n = create::layered::row_size(spec, k);
+            for k in sim.sources[index].inserted..create::layered::max_rows(spec) {
+                let n = create::layered::row_capacity(spec, k);
                 layered_count += n as u32;
                 layered_corners += n * corners;
             }
@@ -663,7 +663,7 @@ impl GpuSimulation {
             .iter()
             .filter_map(|b| {
                 let k = self.sim.sources[b.index].inserted;
-                if k >= create::layered::row_count(&b.spec) {
+                if k >= create::layered::max_rows(&b.spec) {
                     return None;
                 }
                 let due = b.spec.start_time + k as f64 * b.spec.interval;

@@ -388,6 +388,10 @@ pub struct Layered {
     pub gap: f64,
     #[serde(default)]
     pub start_time: f64,
+    /// Rows of this fixed height (in units of the largest particle) instead of rows that
+    /// follow the pile's measured height (the default).
+    #[serde(default)]
+    pub row_height: Option<f64>,
 }
 
 fn default_gap() -> f64 {

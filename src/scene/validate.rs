@@ -401,6 +401,9 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 finite_positive(&at("interval"), s.interval)?;
                 finite_non_negative(&at("gap"), s.gap)?;
                 finite_non_negative(&at("start_time"), s.start_time)?;
+                if let Some(h) = s.row_height {
+                    finite_positive(&at("row_height"), h)?;
+                }
                 if !(s.slope > 0.0 && s.slope < 90.0) {
                     return Err(SceneError::invalid(
                         at("slope"),

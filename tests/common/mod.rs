@@ -93,11 +93,13 @@ pub fn gpu(test: &str) -> Option<talus::gpu::device::Gpu> {
     }
 }
 
-/// A layer-by-layer pile: rows of 16, 13, 10, 7, 4 and 1 unit particles (30° outline)
-/// dropped every 1.5 s from 0.3 d above the pile onto a floor; disks or heptagons.
+/// A layer-by-layer pile of fixed rows: 16, 13, 10, 7, 4 and 1 unit particles (30°
+/// outline, rows (√3/2) d high) dropped every 1.5 s from 0.3 d above the pile onto a
+/// floor; disks or heptagons.
 pub fn layered_pile(polygons: bool) -> serde_json::Value {
     let mut block = json!({ "kind": "layered", "material": "m", "diameter": 1.0,
-                            "base_width": 16.0, "slope": 30.0, "interval": 1.5, "gap": 0.3 });
+                            "base_width": 16.0, "slope": 30.0, "interval": 1.5, "gap": 0.3,
+                            "row_height": 0.8660254037844386 });
     let law = if polygons {
         block["polygon"] = json!({ "corners": 7 });
         json!({ "law": "overlap_area", "k_n": 2000.0, "eta_n": 0.5, "mu": 0.5 })
