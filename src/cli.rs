@@ -503,6 +503,17 @@ fn cmd_reproduce(
             f.row1_dip,
             f.coordination_interior
         );
+        if let (Some(c), Some(l), Some(r)) = (
+            f.base_load_centre_mg,
+            f.base_load_left_max_mg,
+            f.base_load_right_max_mg,
+        ) {
+            out!(
+                "{id} {}: load on the base particles (over {} of them) under the apex {c:.2} m g, largest left {l:.2}, right {r:.2}",
+                v.name,
+                talus::analyze::BASE_SPAN
+            );
+        }
         found.push(f);
     }
     let averages = reproduce::seed_averages(&found);
@@ -546,11 +557,22 @@ fn cmd_reproduce(
             a.coordination_interior
         );
     }
+    let comparisons = reproduce::comparisons(&id, &found);
+    for c in &comparisons {
+        out!(
+            "{id} {} against {}: row-1 S_zz differs by {:.3} of the maximum at most, {:.3} on average",
+            c.variants[0],
+            c.variants[1],
+            c.row1_szz_max_difference,
+            c.row1_szz_mean_difference
+        );
+    }
     let report = serde_json::json!({
         "id": id,
         "full": full,
         "claim": reproduce::claim(&id),
         "seed_averages": averages,
+        "comparisons": comparisons,
         "variants": found,
         "failed": failed,
     });

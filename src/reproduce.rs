@@ -36,7 +36,7 @@ const R8_REDUCED: &str = include_str!("../scenes/r8_polygon_pile_reduced.json");
 /// What R1–R9 reproduce (SPEC 6), in one line each.
 pub fn claim(id: &str) -> &'static str {
     match id {
-        "R1" => "S_xx/S_zz ≈ 1/3 in the interior of row M = 1",
+        "R1" => "S_xx/S_zz ≈ 1/3 in the interior of row M = 1; the same stress for ν = 1 and 3/2",
         "R2" => {
             "dip of S_zz(1) under the apex for c < 0, deepening with |c|; no dip (zig-zag) for c = 1/15"
         }
@@ -83,7 +83,15 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
         x
     };
     Ok(match id {
-        "R1" => vec![lattice("pile", Vec::new())],
+        // ν = 1 and the Hertz exponent 3/2 (paper 000 eq. 2, Fig. 6), δ0 = d0: the
+        // same stress in row 1.
+        "R1" => vec![
+            lattice("pile", Vec::new()),
+            lattice(
+                "pile-nu1.5",
+                vec!["contact.nu=1.5".into(), "contact.delta0=1.5e-3".into()],
+            ),
+        ],
         // R2 and R3: the R1 pile (frictionless, fixed bumpy bottom), its bottom row
         // squeezed or stretched by c, or with size disorder r_d over several seeds. The
         // lattice builder starts them without overlaps, as the paper does
@@ -187,7 +195,8 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
         // R7 reduced: about 30 % of the paper's grains, from the same source. (With
         // 10 % the wedge heaps spread into a layer a few grains high, tried.) Each pour
         // stops 15 s after its last grain, and not before 2 s after it; the layered pile
-        // is √0.3 as wide, for 30 % of the grains. Tens of minutes each on a 2-core CPU.
+        // is √0.3 as wide, for 30 % of the grains, and stops once built and settled.
+        // Tens of minutes each on a 2-core CPU.
         "R7" if !full => {
             let wedge = |name: &str, scene: &'static str, count: u32| {
                 let pour = count as f64 / R7_RATE;
@@ -202,8 +211,7 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
             let mut layered = r7("layered-medium", R7_LAYERED);
             layered.overrides = vec![
                 "particles[0].base_width=0.38".into(),
-                "stop.time=35".into(),
-                "stop.not_before=27".into(),
+                "stop.time=100".into(),
             ];
             vec![
                 wedge("wedge-mono", R7_MONO, 800),
@@ -264,6 +272,12 @@ pub struct Findings {
     pub coordination_interior: f64,
     pub packing_fraction_lower_half: f64,
     pub kinetic_over_elastic: Option<f64>,
+    /// The normal force on the fixed base particles in units of m g (paper 001 Fig. 3b),
+    /// averaged over `analyze::BASE_SPAN` of them: under the apex and the largest on
+    /// the left and on the right; an M profile has both maxima above the centre.
+    pub base_load_centre_mg: Option<f64>,
+    pub base_load_left_max_mg: Option<f64>,
+    pub base_load_right_max_mg: Option<f64>,
 }
 
 pub fn findings(variant: &str, a: &Analysis) -> Findings {
@@ -326,6 +340,9 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
         coordination_interior: s.coordination.interior,
         packing_fraction_lower_half: s.packing_fraction_lower_half,
         kinetic_over_elastic: s.energy.as_ref().map(|e| e.kinetic_over_elastic),
+        base_load_centre_mg: s.base_load.as_ref().map(|b| b.centre / b.grain_weight),
+        base_load_left_max_mg: s.base_load.as_ref().map(|b| b.left_max / b.grain_weight),
+        base_load_right_max_mg: s.base_load.as_ref().map(|b| b.right_max / b.grain_weight),
     }
 }
 
@@ -365,20 +382,14 @@ pub fn seed_averages(found: &[Findings]) -> Vec<SeedAverage> {
                 .collect();
             // Each run's S_zz interpolated at the first run's offsets from the apex.
             let grid: Vec<f64> = runs[0].row1_profile.iter().map(|p| p.0).collect();
-            let at = |p: &[(f64, f64)], x: f64| -> f64 {
-                let k = p.partition_point(|q| q.0 < x);
-                if k == 0 || k == p.len() {
-                    return p.get(k.min(p.len() - 1)).map_or(0.0, |q| q.1);
-                }
-                let (a, b) = (p[k - 1], p[k]);
-                a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
-            };
             let profile: Vec<(f64, f64)> = grid
                 .iter()
                 .map(|&x| {
                     (
                         x,
-                        runs.iter().map(|r| at(&r.row1_profile, x)).sum::<f64>()
+                        runs.iter()
+                            .map(|r| interpolate(&r.row1_profile, x))
+                            .sum::<f64>()
                             / runs.len() as f64,
                     )
                 })
@@ -409,6 +420,62 @@ pub fn seed_averages(found: &[Findings]) -> Vec<SeedAverage> {
         .collect()
 }
 
+/// A profile's value at `x`, linear between its points (sorted by x), its end values
+/// beyond them.
+fn interpolate(p: &[(f64, f64)], x: f64) -> f64 {
+    let k = p.partition_point(|q| q.0 < x);
+    if k == 0 || k == p.len() {
+        return p.get(k.min(p.len() - 1)).map_or(0.0, |q| q.1);
+    }
+    let (a, b) = (p[k - 1], p[k]);
+    a.1 + (b.1 - a.1) * (x - a.0) / (b.0 - a.0)
+}
+
+/// Two variants whose stress the paper finds the same (R1: ν = 1 and 3/2; R8: the three
+/// μ): how far apart their row-1 S_zz profiles are.
+#[derive(Clone, Debug, Serialize)]
+pub struct Comparison {
+    pub variants: [String; 2],
+    /// max |S_zz^a − S_zz^b| over row 1 (b interpolated at a's windows), over a's maximum.
+    pub row1_szz_max_difference: f64,
+    /// The same, averaged over the windows.
+    pub row1_szz_mean_difference: f64,
+    pub stress_ratio_interior_row1: [f64; 2],
+}
+
+/// The comparisons reproduction `id` is judged by: every pair of its variants for R1
+/// and R8, none for the others.
+pub fn comparisons(id: &str, found: &[Findings]) -> Vec<Comparison> {
+    if !matches!(id, "R1" | "R8") {
+        return Vec::new();
+    }
+    let mut out = Vec::new();
+    for (i, a) in found.iter().enumerate() {
+        for b in &found[i + 1..] {
+            let max = a
+                .row1_profile
+                .iter()
+                .map(|p| p.1)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let diff: Vec<f64> = a
+                .row1_profile
+                .iter()
+                .map(|p| (p.1 - interpolate(&b.row1_profile, p.0)).abs() / max)
+                .collect();
+            out.push(Comparison {
+                variants: [a.variant.clone(), b.variant.clone()],
+                row1_szz_max_difference: diff.iter().copied().fold(0.0, f64::max),
+                row1_szz_mean_difference: diff.iter().sum::<f64>() / diff.len().max(1) as f64,
+                stress_ratio_interior_row1: [
+                    a.stress_ratio_interior_row1,
+                    b.stress_ratio_interior_row1,
+                ],
+            });
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -431,7 +498,24 @@ mod tests {
             coordination_interior: 4.0,
             packing_fraction_lower_half: 0.0,
             kinetic_over_elastic: None,
+            base_load_centre_mg: None,
+            base_load_left_max_mg: None,
+            base_load_right_max_mg: None,
         }
+    }
+
+    #[test]
+    fn comparisons_measure_profiles_against_each_other() {
+        // b is a 10 % lower and shifted by half a window: compared at a's windows it
+        // differs by 0.1 of a's maximum at the top, and by the interpolation between.
+        let a = run("a", vec![(-0.2, 0.5), (0.0, 1.0), (0.2, 0.5)]);
+        let b = run("b", vec![(-0.3, 0.45), (-0.1, 0.9), (0.1, 0.9), (0.3, 0.45)]);
+        assert!(comparisons("R4", &[a.clone(), b.clone()]).is_empty());
+        let c = comparisons("R1", &[a, b]);
+        assert_eq!(c.len(), 1);
+        // At −0.2 b is 0.675, at 0 0.9, at 0.2 0.675: differences 0.175, 0.1, 0.175.
+        assert!((c[0].row1_szz_max_difference - 0.175).abs() < 1e-12, "{c:?}");
+        assert!((c[0].row1_szz_mean_difference - 0.15).abs() < 1e-12, "{c:?}");
     }
 
     #[test]

@@ -210,3 +210,53 @@ pub fn wall_pressure(
         })
         .collect()
 }
+
+/// The load on one fixed base particle (paper 001 Fig. 3b: the normal force on the base).
+#[derive(Clone, Debug)]
+pub struct BaseForce {
+    pub grain: usize,
+    pub x: f64,
+    /// The downward force the mobile grains press onto it.
+    pub load: f64,
+}
+
+/// The loads on the fixed grains from the mobile ones, by x; empty without fixed grains
+/// (a wall base is measured by [`wall_pressure`]).
+pub fn base_forces(grains: &[Grain], touches: &[Touch]) -> Vec<BaseForce> {
+    let mut load = vec![0.0; grains.len()];
+    let mut touched = vec![false; grains.len()];
+    for t in touches {
+        let Some(b) = t.b else { continue };
+        // The force on a is t.force, on b its opposite; the load is the force's
+        // downward part on the fixed one.
+        for (k, other, fz) in [(t.a, b, t.force[1]), (b, t.a, -t.force[1])] {
+            if grains[k].fixed && !grains[other].fixed {
+                load[k] -= fz;
+                touched[k] = true;
+            }
+        }
+    }
+    let mut out: Vec<BaseForce> = (0..grains.len())
+        .filter(|&k| grains[k].fixed && touched[k])
+        .map(|k| BaseForce {
+            grain: k,
+            x: grains[k].x,
+            load: load[k],
+        })
+        .collect();
+    out.sort_by(|p, q| p.x.total_cmp(&q.x));
+    out
+}
+
+/// The base loads averaged over `span` neighbouring base particles (an odd number),
+/// fewer at the ends: the M profile without the particle-to-particle raggedness.
+pub fn smoothed_loads(base: &[BaseForce], span: usize) -> Vec<(f64, f64)> {
+    let half = span / 2;
+    (0..base.len())
+        .map(|k| {
+            let (lo, hi) = (k.saturating_sub(half), (k + half + 1).min(base.len()));
+            let mean = base[lo..hi].iter().map(|b| b.load).sum::<f64>() / (hi - lo) as f64;
+            (base[k].x, mean)
+        })
+        .collect()
+}

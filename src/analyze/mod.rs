@@ -62,6 +62,25 @@ pub struct EnergySummary {
     pub kinetic_over_elastic: f64,
 }
 
+/// Base particles over which `BaseLoad` smooths the load profile.
+pub const BASE_SPAN: usize = 5;
+
+/// The normal force on the fixed base particles (paper 001 Fig. 3b), in force units:
+/// its sum (the mobile grains' weight, for a static heap), and, averaged over
+/// `BASE_SPAN` neighbouring base particles, its value under the apex and its largest
+/// value on each side. An M profile has side maxima above the centre.
+#[derive(Clone, Debug, Serialize)]
+pub struct BaseLoad {
+    pub particles: usize,
+    pub total: f64,
+    pub mobile_weight: f64,
+    /// The mean mobile grain's weight m g, the unit of paper 001's F_B/mg.
+    pub grain_weight: f64,
+    pub centre: f64,
+    pub left_max: f64,
+    pub right_max: f64,
+}
+
 /// The scalar results (summary.json).
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
@@ -85,6 +104,8 @@ pub struct Summary {
     /// Mean packing fraction of the layers below half the height.
     pub packing_fraction_lower_half: f64,
     pub oriented_grains: usize,
+    /// The loads on the fixed base particles, when the heap stands on some.
+    pub base_load: Option<BaseLoad>,
     pub energy: Option<EnergySummary>,
     /// Σ_grains Σ_c σ-moment zz (= ∫σ_zz dA) and W (z_cm − base): equal for a static
     /// heap on a flat base (the virial of the vertical forces), a check on the data.
@@ -108,6 +129,7 @@ pub struct Analysis {
     pub windows: Vec<stress::Window>,
     pub surface: Vec<heap::SurfacePoint>,
     pub wall_pressure: Vec<(f64, f64)>,
+    pub base_forces: Vec<heap::BaseForce>,
     pub force_pdf: Vec<(f64, f64)>,
     pub layers: Vec<structure::Layer>,
     pub axes: Vec<Option<f64>>,
@@ -193,6 +215,33 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
     let (force_pdf, mean_f, max_f) = network::force_distribution(&input.touches, 0.1);
     let wall_pressure =
         heap::wall_pressure(grains, &input.touches, &o, opt.window * d, opt.step * d);
+    let base_forces = heap::base_forces(grains, &input.touches);
+    let mobile: Vec<&input::Grain> = grains.iter().filter(|g| !g.fixed).collect();
+    let grain_weight =
+        mobile.iter().map(|g| g.mass).sum::<f64>() / mobile.len().max(1) as f64 * input.g;
+    let base_load = (!base_forces.is_empty()).then(|| {
+        let smooth = heap::smoothed_loads(&base_forces, BASE_SPAN);
+        let centre = smooth
+            .iter()
+            .min_by(|p, q| (p.0 - o.apex_x).abs().total_cmp(&(q.0 - o.apex_x).abs()))
+            .map_or(f64::NAN, |p| p.1);
+        let side_max = |left: bool| {
+            smooth
+                .iter()
+                .filter(|p| (p.0 < o.apex_x) == left)
+                .map(|p| p.1)
+                .fold(f64::NEG_INFINITY, f64::max)
+        };
+        BaseLoad {
+            particles: base_forces.len(),
+            total: base_forces.iter().map(|b| b.load).sum(),
+            mobile_weight: mobile.iter().map(|g| g.mass).sum::<f64>() * input.g,
+            grain_weight,
+            centre,
+            left_max: side_max(true),
+            right_max: side_max(false),
+        }
+    });
     let layers = structure::packing(grains, &o, opt.layer * d, d);
     let lower: Vec<f64> = layers
         .iter()
@@ -240,6 +289,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
         },
         packing_fraction_lower_half: lower.iter().sum::<f64>() / lower.len().max(1) as f64,
         oriented_grains: oriented,
+        base_load,
         energy,
         stress_integral_zz: moments.iter().map(|m| m.zz).sum(),
         weight_times_height: weight_height,
@@ -257,6 +307,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
         windows,
         surface,
         wall_pressure,
+        base_forces,
         force_pdf,
         layers,
         axes,
@@ -420,6 +471,33 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
                 }),
         ),
     )?;
+    if !a.base_forces.is_empty() {
+        let smooth = heap::smoothed_loads(&a.base_forces, BASE_SPAN);
+        let mg = s.base_load.as_ref().map_or(f64::NAN, |b| b.grain_weight);
+        put(
+            "base_forces.csv",
+            table(
+                &h(&[
+                    "id",
+                    &format!("x [{l}]"),
+                    "X = (x - left)/width",
+                    &format!("F_B [{f}]"),
+                    "F_B/mg",
+                    &format!("F_B over {BASE_SPAN} base particles/mg"),
+                ]),
+                a.base_forces.iter().zip(&smooth).map(|(b, sm)| {
+                    vec![
+                        a.input.grains[b.grain].id.to_string(),
+                        v(b.x),
+                        v(xs(b.x)),
+                        v(b.load),
+                        v(b.load / mg),
+                        v(sm.1 / mg),
+                    ]
+                }),
+            ),
+        )?;
+    }
     put(
         "surface.csv",
         table(
