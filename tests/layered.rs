@@ -139,3 +139,18 @@ fn a_bad_row_height_is_an_error_naming_the_key() {
         "{text}"
     );
 }
+
+#[test]
+fn a_run_too_short_for_its_layered_pile_is_warned_about() {
+    // Six fixed rows, one every 1.5: the last is laid at t = 7.5.
+    let mut v = layered_pile(false);
+    v["stop"]["time"] = json!(7.0);
+    let w = talus::scene::warnings(&parse(&v));
+    assert!(
+        w.iter()
+            .any(|w| w.contains("particles[0]") && w.contains("6 rows") && w.contains("t = 7.5")),
+        "{w:?}"
+    );
+    v["stop"]["time"] = json!(8.0);
+    assert!(talus::scene::warnings(&parse(&v)).is_empty());
+}

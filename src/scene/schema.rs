@@ -359,9 +359,9 @@ pub struct Row {
 
 /// Layer-by-layer construction (paper 000 sec. 5.4.2): every `interval` a row of
 /// particles is dropped from `gap` (in units of the largest particle) above the surface
-/// below each of them; each row is narrower than the one before, by 2 h / tan(slope) with
-/// h = (√3/2) d_max, so that the pile grows with the given outline. Rows stop when
-/// narrower than one particle. Particles are drawn as by a point source.
+/// below each of them, where the pile is still below the outline (`base_width`, `slope`);
+/// or, with `row_height`, rows narrowing by 2 h / tan(slope). See `create::layered`.
+/// Particles are drawn as by a point source.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Layered {

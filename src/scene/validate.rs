@@ -418,6 +418,20 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                         format!("{} holds no particle of size up to {d}", s.base_width),
                     ));
                 }
+                // The fewest rows the outline needs: rows of the given height, or
+                // close-packed rows of the largest particle (measured rows of smaller or
+                // settling grains take more).
+                let h = s.row_height.unwrap_or(0.5 * 3f64.sqrt()) * d;
+                let rows = ((s.base_width - d) * s.slope.to_radians().tan() / (2.0 * h))
+                    .floor()
+                    + 1.0;
+                let built = s.start_time + (rows - 1.0) * s.interval;
+                if scene.stop.time < built {
+                    warnings.push(format!(
+                        "particles[{k}]: stop.time = {} ends the run before the layered pile is built: its outline needs at least {rows} rows, one every {} (the last at t = {built})",
+                        scene.stop.time, s.interval
+                    ));
+                }
             }
             Creation::List(l) => {
                 for (q, p) in l.particles.iter().enumerate() {
