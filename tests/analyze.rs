@@ -873,3 +873,65 @@ fn the_base_particles_carry_the_weight_above_them() {
     let mg: f64 = rows[1].split(',').nth(4).unwrap().parse().unwrap();
     assert!((mg - N as f64).abs() < 2e-2, "F_B/mg = {mg}");
 }
+
+#[test]
+fn an_m_shaped_base_load_has_its_side_maxima_above_the_centre() {
+    // 25 fixed base particles at x = 0..24 under 25 mobile grains (the one at x = 12
+    // highest: the apex), each pressing its base particle down with
+    // F_k = 10 + 10 exp(−(k − 4)²/2) + 10 exp(−(k − 20)²/2): an M. The summary gives the
+    // load under the apex and the side maxima, each averaged over 5 base particles.
+    use analyze::input::{Grain, Input, Touch};
+    let f = |k: usize| {
+        let k = k as f64;
+        10.0 + 10.0 * (-(k - 4.0).powi(2) / 2.0).exp() + 10.0 * (-(k - 20.0).powi(2) / 2.0).exp()
+    };
+    let grain = |id: u32, x: f64, z: f64, fixed: bool| Grain {
+        id,
+        x,
+        z,
+        theta: 0.0,
+        radius: 0.5,
+        mass: 1.0,
+        fixed,
+        area: std::f64::consts::FRAC_PI_4,
+        corners: Vec::new(),
+    };
+    let mut grains = Vec::new();
+    let mut touches = Vec::new();
+    for k in 0..25 {
+        grains.push(grain(k, k as f64, 0.5, true));
+        let top = if k == 12 { 1.6 } else { 1.5 };
+        grains.push(grain(100 + k, k as f64, top, false));
+        touches.push(Touch {
+            a: 2 * k as usize + 1,
+            b: Some(2 * k as usize),
+            force: [0.0, f(k as usize)],
+            normal_force: f(k as usize),
+            point: [k as f64, 1.0],
+        });
+    }
+    let input = Input {
+        source: PathBuf::from("m-profile"),
+        scene: "m-profile".into(),
+        units: "reduced".into(),
+        step: 0,
+        time: 0.0,
+        grains,
+        touches,
+        g: 1.0,
+        mu: None,
+        log: None,
+        length_unit: "sigma".into(),
+        force_unit: "m g".into(),
+    };
+    let a = analyze::analyze(input, &Options::default()).unwrap();
+    assert_eq!(a.base_forces.len(), 25);
+    let load = a.summary.base_load.unwrap();
+    let mean = |c: usize| (c - 2..=c + 2).map(f).sum::<f64>() / 5.0;
+    assert!((load.centre - mean(12)).abs() < 1e-12, "{load:?}");
+    assert!((load.left_max - mean(4)).abs() < 1e-12, "{load:?}");
+    assert!((load.right_max - mean(20)).abs() < 1e-12, "{load:?}");
+    assert!(load.left_max > 1.2 * load.centre && load.right_max > 1.2 * load.centre);
+    let total: f64 = (0..25).map(f).sum();
+    assert!((load.total - total).abs() < 1e-9);
+}

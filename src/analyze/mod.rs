@@ -68,7 +68,9 @@ pub const BASE_SPAN: usize = 5;
 /// The normal force on the fixed base particles (paper 001 Fig. 3b), in force units:
 /// its sum (the mobile grains' weight, for a static heap), and, averaged over
 /// `BASE_SPAN` neighbouring base particles, its value under the apex and its largest
-/// value on each side. An M profile has side maxima above the centre.
+/// value on each side (from `BASE_SPAN` particles beyond the one under the apex, so that
+/// the sides share no particle with the centre's average). An M profile has side maxima
+/// above the centre.
 #[derive(Clone, Debug, Serialize)]
 pub struct BaseLoad {
     pub particles: usize,
@@ -221,15 +223,27 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
         mobile.iter().map(|g| g.mass).sum::<f64>() / mobile.len().max(1) as f64 * input.g;
     let base_load = (!base_forces.is_empty()).then(|| {
         let smooth = heap::smoothed_loads(&base_forces, BASE_SPAN);
-        let centre = smooth
-            .iter()
-            .min_by(|p, q| (p.0 - o.apex_x).abs().total_cmp(&(q.0 - o.apex_x).abs()))
-            .map_or(f64::NAN, |p| p.1);
+        let c = (0..smooth.len())
+            .min_by(|&p, &q| {
+                (smooth[p].0 - o.apex_x)
+                    .abs()
+                    .total_cmp(&(smooth[q].0 - o.apex_x).abs())
+            })
+            .unwrap_or(0);
+        let centre = smooth[c].1;
+        // The sides start beyond the particles averaged into the centre's value.
         let side_max = |left: bool| {
             smooth
                 .iter()
-                .filter(|p| (p.0 < o.apex_x) == left)
-                .map(|p| p.1)
+                .enumerate()
+                .filter(|(k, _)| {
+                    if left {
+                        k + BASE_SPAN <= c
+                    } else {
+                        *k >= c + BASE_SPAN
+                    }
+                })
+                .map(|(_, p)| p.1)
                 .fold(f64::NEG_INFINITY, f64::max)
         };
         BaseLoad {
