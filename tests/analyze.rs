@@ -926,7 +926,7 @@ fn an_m_shaped_base_load_has_its_side_maxima_above_the_centre() {
     };
     let a = analyze::analyze(input, &Options::default()).unwrap();
     assert_eq!(a.base_forces.len(), 25);
-    let load = a.summary.base_load.unwrap();
+    let load = a.summary.base_load.clone().unwrap();
     let mean = |c: usize| (c - 2..=c + 2).map(f).sum::<f64>() / 5.0;
     assert!((load.centre - mean(12)).abs() < 1e-12, "{load:?}");
     assert!((load.left_max - mean(4)).abs() < 1e-12, "{load:?}");
@@ -934,4 +934,9 @@ fn an_m_shaped_base_load_has_its_side_maxima_above_the_centre() {
     assert!(load.left_max > 1.2 * load.centre && load.right_max > 1.2 * load.centre);
     let total: f64 = (0..25).map(f).sum();
     assert!((load.total - total).abs() < 1e-9);
+    // Drawn as paper 001 Fig. 3b: the force on each base particle and its average.
+    let dir = tmp("m-profile");
+    talus::render::render(&a, &dir, talus::render::Field::Plain, 400).unwrap();
+    let svg = std::fs::read_to_string(dir.join("base_forces.svg")).unwrap();
+    assert!(svg.contains("F_B / m g") && svg.contains("over 5"), "axis and legend");
 }

@@ -1,5 +1,6 @@
 //! Plots of the profiles as SVG (plotters): S_zz and S_xx along the base against
-//! X = x/l (paper 000 Fig. 3, 6, 14), P(f/⟨f⟩), and f(θ).
+//! X = x/l (paper 000 Fig. 3, 6, 14), the force on fixed base particles (paper 001
+//! Fig. 3b), P(f/⟨f⟩), and f(θ).
 
 use crate::analyze::Analysis;
 use crate::files::write_atomic;
@@ -111,6 +112,32 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
         ],
     )?;
     files.push(p);
+    if let Some(load) = &a.summary.base_load {
+        // Paper 001 Fig. 3b: the normal force on each base particle in units of m g.
+        let mg = load.grain_weight;
+        let smooth =
+            crate::analyze::heap::smoothed_loads(&a.base_forces, crate::analyze::BASE_SPAN);
+        let p = dir.join("base_forces.svg");
+        plot(
+            &p,
+            &format!("{}: normal force on the base particles", a.summary.scene),
+            "X = x / l",
+            "F_B / m g",
+            &[
+                (
+                    "each",
+                    RGBColor(150, 150, 150),
+                    a.base_forces.iter().map(|b| (xs(b.x), b.load / mg)).collect(),
+                ),
+                (
+                    "over 5",
+                    BLUE,
+                    smooth.iter().map(|&(x, f)| (xs(x), f / mg)).collect(),
+                ),
+            ],
+        )?;
+        files.push(p);
+    }
     let p = dir.join("force_distribution.svg");
     plot(
         &p,
