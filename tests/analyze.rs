@@ -93,6 +93,15 @@ fn a_resting_column_carries_its_weight_grain_by_grain() {
     let mean: f64 = a.force_pdf.iter().map(|p| p.0 * p.1 * bin).sum();
     assert!((total - 1.0).abs() < 1e-12, "∫P = {total}");
     assert!((mean - 1.0).abs() < 0.05, "mean f/<f> = {mean}");
+    // Every grain is compressed vertically: P(φ) has all its weight at φ = π/2.
+    let width = a.principal_directions[1].0 - a.principal_directions[0].0;
+    let vertical: f64 = a
+        .principal_directions
+        .iter()
+        .filter(|p| (p.0 - std::f64::consts::FRAC_PI_2).abs() < 0.6 * width)
+        .map(|p| p.1 * width)
+        .sum();
+    assert!((vertical - 1.0).abs() < 1e-12, "P(φ): {:?}", a.principal_directions);
 }
 
 #[test]
@@ -193,6 +202,7 @@ fn the_command_writes_its_tables_and_rejects_bad_input() {
         "packing.csv",
         "orientation.csv",
         "orientation_correlation.csv",
+        "principal_directions.csv",
     ] {
         assert!(out.join(f).is_file(), "{f} written");
     }

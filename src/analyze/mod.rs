@@ -137,6 +137,8 @@ pub struct Analysis {
     pub axes: Vec<Option<f64>>,
     pub orientation: Vec<(f64, f64)>,
     pub correlation: Vec<(f64, f64, usize)>,
+    /// P(φ) of the particles' principal stress directions.
+    pub principal_directions: Vec<(f64, f64)>,
 }
 
 /// As `analyze`, with the stress tables averaged over `earlier` snapshots as well (same
@@ -264,6 +266,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
         .collect();
     let axes: Vec<Option<f64>> = grains.iter().map(structure::long_axis).collect();
     let (orientation, oriented) = structure::orientation(&axes, 18);
+    let (principal_directions, _) = stress::principal_directions(&moments, 18);
     let correlation = structure::orientation_correlation(grains, &axes, 0.5 * d, 10.0 * d);
     let energy = input.log.as_ref().and_then(|(h, rows)| {
         let last = rows.last()?;
@@ -327,6 +330,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
         axes,
         orientation,
         correlation,
+        principal_directions,
     })
 }
 
@@ -559,6 +563,13 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
         table(
             &h(&["theta [rad]", "f(theta) [1/rad]"]),
             a.orientation.iter().map(|&(t, p)| vec![v(t), v(p)]),
+        ),
+    )?;
+    put(
+        "principal_directions.csv",
+        table(
+            &h(&["phi [rad]", "P(phi) [1/rad]"]),
+            a.principal_directions.iter().map(|&(t, p)| vec![v(t), v(p)]),
         ),
     )?;
     put(

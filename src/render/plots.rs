@@ -1,6 +1,7 @@
 //! Plots of the profiles as SVG (plotters): S_zz and S_xx along the base against
 //! X = x/l (paper 000 Fig. 3, 6, 14), the force on fixed base particles (paper 001
-//! Fig. 3b), P(f/⟨f⟩), and f(θ).
+//! Fig. 3b), P(f/⟨f⟩), f(θ), and P(φ) of the principal stress directions (paper 004
+//! Fig. 5).
 
 use crate::analyze::Analysis;
 use crate::files::write_atomic;
@@ -145,6 +146,15 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
         "f / <f>",
         "P(f / <f>)",
         &[("P", BLACK, a.force_pdf.clone())],
+    )?;
+    files.push(p);
+    let p = dir.join("principal_directions.svg");
+    plot(
+        &p,
+        "principal stress directions of the grains",
+        "phi [rad]",
+        "P(phi) [1/rad]",
+        &[("P", BLACK, a.principal_directions.clone())],
     )?;
     files.push(p);
     if a.summary.oriented_grains > 0 {
