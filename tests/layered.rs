@@ -132,7 +132,7 @@ fn measured_rows_build_the_outline_asked_for() {
 fn a_bad_row_height_is_an_error_naming_the_key() {
     let mut v = layered_pile(false);
     v["particles"][0]["row_height"] = json!(-0.5);
-    let err = talus::scene::parse(&v.to_string(), &[]).err().expect("rejected");
+    let err = talus::scene::parse(&v.to_string(), &[]).expect_err("rejected");
     let text = err.to_string();
     assert!(
         text.contains("particles[0].row_height") && text.contains("must be positive"),
