@@ -134,27 +134,12 @@ pub fn moving_averages(
 /// The polar distribution P(φ) of the particles' principal directions (paper 004 sec. 3,
 /// Fig. 5): the angle φ ∈ [0, π) of the larger eigenvalue of each loaded particle's own
 /// stress (`moments`; grains with no contact left out), in `bins` bins, normalised so
-/// that ∫ P dφ = 1. Returns the bins and the number of particles counted.
+/// that ∫ P dφ = 1 (binned as f(θ) is). Returns the bins and the number of particles
+/// counted.
 pub fn principal_directions(moments: &[Tensor], bins: usize) -> (Vec<(f64, f64)>, usize) {
-    let width = std::f64::consts::PI / bins as f64;
-    let mut h = vec![0usize; bins];
-    let mut n = 0;
-    for m in moments.iter().filter(|m| **m != Tensor::default()) {
-        let (_, _, phi) = m.principal();
-        h[((phi / width) as usize).min(bins - 1)] += 1;
-        n += 1;
-    }
-    let p = h
+    let angles: Vec<Option<f64>> = moments
         .iter()
-        .enumerate()
-        .map(|(k, &c)| {
-            let density = if n > 0 {
-                c as f64 / (n as f64 * width)
-            } else {
-                0.0
-            };
-            ((k as f64 + 0.5) * width, density)
-        })
+        .map(|m| (*m != Tensor::default()).then(|| m.principal().2))
         .collect();
-    (p, n)
+    super::structure::orientation(&angles, bins)
 }
