@@ -509,13 +509,22 @@ mod tests {
         // b is a 10 % lower and shifted by half a window: compared at a's windows it
         // differs by 0.1 of a's maximum at the top, and by the interpolation between.
         let a = run("a", vec![(-0.2, 0.5), (0.0, 1.0), (0.2, 0.5)]);
-        let b = run("b", vec![(-0.3, 0.45), (-0.1, 0.9), (0.1, 0.9), (0.3, 0.45)]);
+        let b = run(
+            "b",
+            vec![(-0.3, 0.45), (-0.1, 0.9), (0.1, 0.9), (0.3, 0.45)],
+        );
         assert!(comparisons("R4", &[a.clone(), b.clone()]).is_empty());
         let c = comparisons("R1", &[a, b]);
         assert_eq!(c.len(), 1);
         // At −0.2 b is 0.675, at 0 0.9, at 0.2 0.675: differences 0.175, 0.1, 0.175.
-        assert!((c[0].row1_szz_max_difference - 0.175).abs() < 1e-12, "{c:?}");
-        assert!((c[0].row1_szz_mean_difference - 0.15).abs() < 1e-12, "{c:?}");
+        assert!(
+            (c[0].row1_szz_max_difference - 0.175).abs() < 1e-12,
+            "{c:?}"
+        );
+        assert!(
+            (c[0].row1_szz_mean_difference - 0.15).abs() < 1e-12,
+            "{c:?}"
+        );
     }
 
     #[test]

@@ -101,7 +101,11 @@ fn a_resting_column_carries_its_weight_grain_by_grain() {
         .filter(|p| (p.0 - std::f64::consts::FRAC_PI_2).abs() < 0.6 * width)
         .map(|p| p.1 * width)
         .sum();
-    assert!((vertical - 1.0).abs() < 1e-12, "P(φ): {:?}", a.principal_directions);
+    assert!(
+        (vertical - 1.0).abs() < 1e-12,
+        "P(φ): {:?}",
+        a.principal_directions
+    );
 }
 
 #[test]
@@ -872,13 +876,20 @@ fn the_base_particles_carry_the_weight_above_them() {
         );
     }
     let load = a.summary.base_load.as_ref().unwrap();
-    assert!((load.total / load.mobile_weight - 1.0).abs() < 2e-3, "{load:?}");
+    assert!(
+        (load.total / load.mobile_weight - 1.0).abs() < 2e-3,
+        "{load:?}"
+    );
     assert!((load.grain_weight - 1.0).abs() < 1e-12);
     // The table: one row per base particle, F_B/mg = N.
     analyze::write(&a, &dir.join("analysis")).unwrap();
     let csv = std::fs::read_to_string(dir.join("analysis/base_forces.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
-    assert!(rows[0].contains("F_B [m g]"), "units in the header: {}", rows[0]);
+    assert!(
+        rows[0].contains("F_B [m g]"),
+        "units in the header: {}",
+        rows[0]
+    );
     assert_eq!(rows.len(), 3, "{csv}");
     let mg: f64 = rows[1].split(',').nth(4).unwrap().parse().unwrap();
     assert!((mg - N as f64).abs() < 2e-2, "F_B/mg = {mg}");
@@ -948,5 +959,8 @@ fn an_m_shaped_base_load_has_its_side_maxima_above_the_centre() {
     let dir = tmp("m-profile");
     talus::render::render(&a, &dir, talus::render::Field::Plain, 400).unwrap();
     let svg = std::fs::read_to_string(dir.join("base_forces.svg")).unwrap();
-    assert!(svg.contains("F_B / m g") && svg.contains("over 5"), "axis and legend");
+    assert!(
+        svg.contains("F_B / m g") && svg.contains("over 5"),
+        "axis and legend"
+    );
 }

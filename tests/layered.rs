@@ -67,7 +67,8 @@ fn built_pile(row_height: Option<f64>) -> (f64, f64, f64, usize) {
     v["contact"]["mu"] = json!(0.6);
     let block = &mut v["particles"][0];
     block.as_object_mut().unwrap().remove("diameter");
-    block["polygon"] = json!({ "corners": 7, "irregular": true, "axes": [0.8, { "uniform": [0.8, 1.1] }] });
+    block["polygon"] =
+        json!({ "corners": 7, "irregular": true, "axes": [0.8, { "uniform": [0.8, 1.1] }] });
     block["base_width"] = json!(24.0);
     block["interval"] = json!(1.0);
     match row_height {

@@ -569,7 +569,9 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
         "principal_directions.csv",
         table(
             &h(&["phi [rad]", "P(phi) [1/rad]"]),
-            a.principal_directions.iter().map(|&(t, p)| vec![v(t), v(p)]),
+            a.principal_directions
+                .iter()
+                .map(|&(t, p)| vec![v(t), v(p)]),
         ),
     )?;
     put(

@@ -128,7 +128,10 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
                 (
                     "each",
                     RGBColor(150, 150, 150),
-                    a.base_forces.iter().map(|b| (xs(b.x), b.load / mg)).collect(),
+                    a.base_forces
+                        .iter()
+                        .map(|b| (xs(b.x), b.load / mg))
+                        .collect(),
                 ),
                 (
                     "over 5",

@@ -422,9 +422,8 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 // close-packed rows of the largest particle (measured rows of smaller or
                 // settling grains take more).
                 let h = s.row_height.unwrap_or(0.5 * 3f64.sqrt()) * d;
-                let rows = ((s.base_width - d) * s.slope.to_radians().tan() / (2.0 * h))
-                    .floor()
-                    + 1.0;
+                let rows =
+                    ((s.base_width - d) * s.slope.to_radians().tan() / (2.0 * h)).floor() + 1.0;
                 let built = s.start_time + (rows - 1.0) * s.interval;
                 if scene.stop.time < built {
                     warnings.push(format!(
