@@ -109,6 +109,9 @@ struct ContactOut {
     ft: vec4<f32>,
     // f_n, f_t, overlap, elastic energy
     info: vec4<f32>,
+    // the geometry the force was computed with: the normal (n_x, n_z) from j to i and
+    // the contact point relative to i's centre (for outputs; issue 19)
+    geo: vec4<f32>,
 };
 
 // A segment a-b; both end points in fixed point, ab = b - a in length units.

@@ -1,6 +1,6 @@
 // Stage (src/forces.rs `contact_forces`): each contact on its own: geometry, relative
-// velocity at the contact point, law. Stores the force on i, both torques, and the
-// updated history; flags a diverging contact.
+// velocity at the contact point, law. Stores the force on i, both torques, the normal
+// and contact point it used, and the updated history; flags a diverging contact.
 
 fn velocity(i: u32) -> vec3<f32> {
     return state[i].q[1].xyz / params.dt;
@@ -64,7 +64,8 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         let res = evaluate(input);
         let f = res.f_n * g.n + res.f_t * t;
         contact_out[slot] = ContactOut(vec4<f32>(f, cross2(l1, f), -cross2(l2, f)),
-                                       vec4<f32>(res.f_n, res.f_t, g.delta, res.energy));
+                                       vec4<f32>(res.f_n, res.f_t, g.delta, res.energy),
+                                       vec4<f32>(g.n, l1));
         hist_out[slot] = res.history;
         let finite = abs(f.x) <= 3.0e38 && abs(f.y) <= 3.0e38;
         if (!finite) { halt(HALT_NOT_FINITE, i); }

@@ -86,14 +86,21 @@ struct Clip {
     line: array<array<u32, MAX_CLIP>, 2>,
 };
 
-fn shoelace(c: ptr<function, Clip>, b: u32, n: u32) -> f32 {
+// The clipped polygon's area about its first corner (a fan of triangles from it, not
+// the frame's origin: issue 18), and its extent, the largest distance of a corner from
+// the first. The f32 area is off by about extent x the clip coordinates' rounding.
+fn shoelace(c: ptr<function, Clip>, b: u32, n: u32) -> vec2<f32> {
+    let o = (*c).v[b][0];
     var a = 0.0;
-    for (var k = 0u; k < n; k++) {
-        let p = (*c).v[b][k];
-        let q = (*c).v[b][(k + 1u) % n];
+    var extent = 0.0;
+    for (var k = 1u; k + 1u < n; k++) {
+        let p = (*c).v[b][k] - o;
+        let q = (*c).v[b][k + 1u] - o;
         a += p.x * q.y - q.x * p.y;
+        extent = max(extent, length(q));
     }
-    return 0.5 * a;
+    if (n > 1u) { extent = max(extent, length((*c).v[b][1] - o)); }
+    return vec2<f32>(0.5 * a, extent);
 }
 
 // Mean of the corners: the fallback force point. Unlike the area centroid it needs no
@@ -163,10 +170,12 @@ fn make_frame(h: vec2<i32>, s: vec2<f32>, n: vec2<f32>) -> Frame {
     return Frame(o, vec2<i32>(round(n * Q30)), n, vec2<f32>(n.y, -n.x), vec2<f32>(o - h), h);
 }
 
-// (u, w) of corner m: u along the line from f32 (it only needs to be right relative
-// to the overlap's length), w exact.
+// (u, w) of corner m: w exact; u along the line from the exact integer offset of the
+// corner from the frame point o, rounded once in f32, so a corner near the contact
+// keeps f32's relative precision of its small distance from it (issue 19).
 fn corner_uw(o: ptr<function, Outline>, m: u32, fr: Frame) -> vec2<f32> {
-    return vec2<f32>(dot(corner_at(o, m, fr.h) - fr.at, fr.t), corner_w(o, m, fr));
+    let x = vec2<f32>((*o).w[m] - fr.o) + corner_e(o, m);
+    return vec2<f32>(dot(x, fr.t), corner_w(o, m, fr));
 }
 
 // (x - o).n of corner m, from an exact 64-bit dot product.
@@ -189,17 +198,19 @@ fn cross_units(aw: vec2<i32>, ae: vec2<f32>, bw: vec2<i32>, be: vec2<f32>,
         + (abe.x * f32(ax.y) - abe.y * f32(ax.x));
 }
 
-// Where a segment whose ends are at signed distances dx, dy crosses a line (0 at x).
-fn crossing_param(dx: f32, dy: f32) -> f32 {
-    if (dx == dy) { return 0.5; }
-    return clamp(dx / (dx - dy), 0.0, 1.0);
+// Where a segment whose ends are at signed distances dx, dy crosses a line: the
+// parameter from each end, (s, 1 - s), each its own quotient (1 - s taken from s near
+// 1 would keep only f32's absolute precision, 6e-8, of a small number).
+fn crossing_param(dx: f32, dy: f32) -> vec2<f32> {
+    if (dx == dy) { return vec2<f32>(0.5); }
+    return clamp(vec2<f32>(dx, -dy) / (dx - dy), vec2<f32>(0.0), vec2<f32>(1.0));
 }
 
-// w at parameter s between ends with wx, wy, from the nearer end; and the size of its
-// error in units of the parameter's relative error.
-fn interpolate_w(wx: f32, wy: f32, s: f32) -> vec2<f32> {
-    if (s <= 0.5) { return vec2<f32>(wx + s * (wy - wx), s * abs(wy - wx)); }
-    return vec2<f32>(wy + (1.0 - s) * (wx - wy), (1.0 - s) * abs(wy - wx));
+// w at parameters s = (from x, from y) between ends with wx, wy, from the nearer end;
+// and the size of its error in units of the parameter's relative error.
+fn interpolate_w(wx: f32, wy: f32, s: vec2<f32>) -> vec2<f32> {
+    if (s.x <= 0.5) { return vec2<f32>(wx + s.x * (wy - wx), s.x * abs(wy - wx)); }
+    return vec2<f32>(wy + s.y * (wx - wy), s.y * abs(wy - wx));
 }
 
 // (u, w) of the crossing of p's edge mp with q's edge mq, interpolated along the
@@ -299,12 +310,16 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
     }
     let n = count[cur];
     if (n < 3u) { return no_contact(); }
-    let area = shoelace(&c, cur, n);
-    if (area <= 0.0) { return no_contact(); }
+    // The f32 area decides only where it is clearly positive or negative; a sliver
+    // within its rounding (~1e-6 extent x scale) is decided by the exact area below.
+    let scale = length(cj - ci) + r;
+    let sh = shoelace(&c, cur, n);
+    let margin = 1.0e-6 * sh.y * scale;
+    if (sh.x <= -margin) { return no_contact(); }
     var g = no_contact();
-    g.area = area;
+    g.area = sh.x;
     g.found = true;
-    if (only_area) { return g; }
+    if (only_area && sh.x > margin) { return g; }
     // The two crossings farthest apart.
     var best = -1.0;
     var xa = vec2<f32>(0.0);
@@ -319,11 +334,12 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
             if (d > best) { best = d; xa = c.v[cur][i]; xb = c.v[cur][j]; ia = i; ib = j; }
         }
     }
-    let scale = length(cj - ci) + r;
     var along = vec2<f32>(0.0, 1.0);
     if (length(cj - ci) > 0.0) { along = (ci - cj) / length(cj - ci); }
+    // The f32 crossings carry ~6e-8 scale: a chord several times that still gives the
+    // frame's direction; the chord's size and the normal come from the exact crossings.
     let chord = length(xb - xa);
-    if (best >= 0.0 && chord > 1.0e-6 * scale) {
+    if (best >= 0.0 && chord > 4.0e-7 * scale) {
         let t = (xb - xa) / chord;
         var nn = vec2<f32>(-t.y, t.x);
         let s = 0.5 * (xa + xb);
@@ -342,7 +358,7 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
         let ub = vertex_uw(p, q, &c, cur, n, ib, fr);
         let d = ub - ua;
         let len = length(d);
-        if (len > 1.0e-6 * scale) {
+        if (len > 1.0e-7 * scale) {
             let tt = (d.x * fr.t + d.y * fr.n) / len;
             g.n = vec2<f32>(-tt.y, tt.x) * sign(dot(vec2<f32>(-tt.y, tt.x), nn));
             g.chord = len;
@@ -353,13 +369,14 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
             g.point = s;
             g.chord = chord;
         }
-        g.area = max(exact_area(p, q, &c, cur, n, fr), 0.0);
+        g.area = exact_area(p, q, &c, cur, n, fr);
     } else {
         g.n = along;
         g.point = corner_mean(&c, cur, n);
         g.chord = 0.0;
-        g.area = max(exact_area(p, q, &c, cur, n, make_frame(h, g.point, g.n)), 0.0);
+        g.area = exact_area(p, q, &c, cur, n, make_frame(h, g.point, g.n));
     }
+    if (g.area <= 0.0) { return no_contact(); }
     g.l = reduced_arm(length(g.point - ci), length(g.point - cj), scale);
     return g;
 }
@@ -368,9 +385,10 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
 // wall segment wa-wb: the part of p beyond the wall's line and between its end points.
 // For an axis-aligned wall whose line is exact in `oa` (the offset of its end a) the
 // area is recomputed exactly: w is then a corner's exact distance from the wall's line,
-// zero on it, and interpolated along p's edge where an edge crosses an end line.
+// zero on it, and interpolated along p's edge where an edge crosses an end line; u is
+// measured from p's deepest corner, from exact integer offsets.
 fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, oa: Offset,
-                only_area: bool) -> AreaContact {
+                wall_ab: vec2<f32>, only_area: bool) -> AreaContact {
     let ab = wb - wa;
     let len = length(ab);
     if (len == 0.0) { return no_contact(); }
@@ -378,28 +396,34 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, oa: Off
     if (dot(m, -wa) < 0.0) { m = -m; }
     var c: Clip;
     let np = (*p).n;
+    var r = 0.0;
+    var deepest = 0u;
     for (var k = 0u; k < np; k++) {
         c.v[0][k] = corner_at(p, k, vec2<i32>(0));
         c.line[0][k] = k;
+        r = max(r, length(c.v[0][k]));
+        if (dot(c.v[0][k], m) < dot(c.v[0][deepest], m)) { deepest = k; }
     }
     var n = clip_lines(&c, 0u, np, wa, -m, WALL_LINE);
     n = clip_lines(&c, 1u, n, wa, ab, END_A_LINE);
     n = clip_lines(&c, 0u, n, wb, -ab, END_B_LINE);
     if (n < 3u) { return no_contact(); }
-    let area = shoelace(&c, 1u, n);
-    if (area <= 0.0) { return no_contact(); }
+    // As for two polygons: the f32 area decides only outside its rounding.
+    let sh = shoelace(&c, 1u, n);
+    let margin = 1.0e-6 * sh.y * r;
+    if (sh.x <= -margin) { return no_contact(); }
     var g = no_contact();
-    g.area = area;
+    g.area = sh.x;
     g.found = true;
-    if (only_area) { return g; }
-    var r = 0.0;
-    for (var k = 0u; k < np; k++) { r = max(r, length(corner_at(p, k, vec2<i32>(0)))); }
+    if (only_area && sh.x > margin) { return g; }
     let scale = len + r;
     var lo = 3.0e38;
     var hi = -3.0e38;
     for (var k = 0u; k < n; k++) {
+        // Corners on the wall's line (crossings, or a wall end inside p), by the lines
+        // they join.
         let x = c.v[1][k];
-        if (abs(dot(x - wa, m)) <= 1.0e-6 * scale) {
+        if (c.line[1][(k + n - 1u) % n] == WALL_LINE || c.line[1][k] == WALL_LINE) {
             let s = dot(x - wa, ab) / len;
             lo = min(lo, s);
             hi = max(hi, s);
@@ -417,40 +441,47 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, oa: Off
     // Exact for an axis-aligned wall: the normal along axis k, the wall's line exact in
     // oa. The area as for two polygons, with w a corner's distance from the wall's line
     // (zero on it); the chord from the crossings' u, interpolated with exact parameters.
-    let k = select(0u, 1u, ab.y == 0.0);
-    if ((ab.x == 0.0 || ab.y == 0.0) && abs(oa.da[k]) <= 1) {
+    // Whether the wall is axis-aligned is the host's exact b - a (`wall_ab`): wa and wb
+    // are f32 offsets that need not be exact when an end is more than a cell away; only
+    // the coordinate along the normal must be, a cell at most away.
+    let k = select(0u, 1u, wall_ab.y == 0.0);
+    if ((wall_ab.x == 0.0 || wall_ab.y == 0.0) && abs(oa.da[k]) <= 1) {
         let sign = m[k];
         let t = vec2<f32>(m.y, -m.x);
-        let first = wall_uw(p, &c, n, 0u, oa, k, sign, t);
+        let base = (*p).w[deepest];
+        let first = wall_uw(p, &c, n, 0u, oa, k, sign, t, base);
         var prev = first;
         var a = 0.0;
         var lo2 = 3.0e38;
         var hi2 = -3.0e38;
         for (var e = 1u; e <= n; e++) {
             var x = first;
-            if (e < n) { x = wall_uw(p, &c, n, e, oa, k, sign, t); }
+            if (e < n) { x = wall_uw(p, &c, n, e, oa, k, sign, t, base); }
             a += (prev.y + x.y) * (prev.x - x.x);
             if (x.z > 0.0) { lo2 = min(lo2, x.x); hi2 = max(hi2, x.x); }
             prev = x;
         }
-        g.area = max(0.5 * a, 0.0);
+        g.area = 0.5 * a;
         if (hi2 > lo2) {
             g.chord = hi2 - lo2;
-            g.point = (0.5 * (lo2 + hi2)) * t + dot(wa, m) * m;
+            g.point = (0.5 * (lo2 + hi2) + dot(vec2<f32>(base), t)) * t + dot(wa, m) * m;
             g.l = max(length(g.point), 1.0e-6 * scale);
         }
     }
+    if (g.area <= 0.0) { return no_contact(); }
     return g;
 }
 
 // (u, w, on the wall's line) of corner e of the clipped polygon (buffer 1), for an
-// axis-aligned wall (normal `sign` along axis k, t along the wall).
+// axis-aligned wall (normal `sign` along axis k, t along the wall); u from the integer
+// point `base` near the contact.
 fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, oa: Offset,
-           k: u32, sign: f32, t: vec2<f32>) -> vec3<f32> {
+           k: u32, sign: f32, t: vec2<f32>, base: vec2<i32>) -> vec3<f32> {
     let lin = (*c).line[1][(e + n - 1u) % n];
     let lout = (*c).line[1][e];
     let np = (*p).n;
     let at = (*c).v[1][e];
+    let u_at = dot(at - vec2<f32>(base), t);
     var edge = lout;
     if (lin < Q_LINE) { edge = lin; }
     if (lin == WALL_LINE || lout == WALL_LINE) {
@@ -460,14 +491,13 @@ fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, oa
             let wx = corner_wall_w(p, edge, oa, k, sign);
             let wy = corner_wall_w(p, y, oa, k, sign);
             let s = crossing_param(wx, wy);
-            let u = interpolate_w(dot(corner_at(p, edge, vec2<i32>(0)), t),
-                                  dot(corner_at(p, y, vec2<i32>(0)), t), s).x;
+            let u = interpolate_w(corner_u(p, edge, base, t), corner_u(p, y, base, t), s).x;
             return vec3<f32>(u, 0.0, 1.0);
         }
-        return vec3<f32>(dot(at, t), 0.0, 1.0);   // an end point of the wall
+        return vec3<f32>(u_at, 0.0, 1.0);   // an end point of the wall
     }
     if (lin < Q_LINE && lout < Q_LINE && lout == (lin + 1u) % np) {
-        return vec3<f32>(dot(at, t), corner_wall_w(p, lout, oa, k, sign), 0.0);
+        return vec3<f32>(corner_u(p, lout, base, t), corner_wall_w(p, lout, oa, k, sign), 0.0);
     }
     if (edge < Q_LINE) {
         // An edge of p across an end line: along the edge, from its nearer end.
@@ -475,10 +505,16 @@ fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, oa
         let xf = corner_at(p, edge, vec2<i32>(0));
         let d = corner_at(p, y, vec2<i32>(0)) - xf;
         let s = clamp(dot(at - xf, d) / max(dot(d, d), 1.0e-30), 0.0, 1.0);
-        let w = interpolate_w(corner_wall_w(p, edge, oa, k, sign), corner_wall_w(p, y, oa, k, sign), s).x;
-        return vec3<f32>(dot(at, t), w, 0.0);
+        let w = interpolate_w(corner_wall_w(p, edge, oa, k, sign), corner_wall_w(p, y, oa, k, sign),
+                              vec2<f32>(s, 1.0 - s)).x;
+        return vec3<f32>(u_at, w, 0.0);
     }
-    return vec3<f32>(dot(at, t), sign * (at[k] - (vec2<f32>(oa.d) + oa.e)[k]), 0.0);
+    return vec3<f32>(u_at, sign * (at[k] - (vec2<f32>(oa.d) + oa.e)[k]), 0.0);
+}
+
+// Corner m along t from the integer point `base` (exact offset, one rounding).
+fn corner_u(p: ptr<function, Outline>, m: u32, base: vec2<i32>, t: vec2<f32>) -> f32 {
+    return dot(vec2<f32>((*p).w[m] - base) + corner_e(p, m), t);
 }
 
 fn corner_wall_w(p: ptr<function, Outline>, m: u32, oa: Offset, k: u32, sign: f32) -> f32 {
@@ -522,7 +558,7 @@ fn polygon_wall_iw(i: u32, w: u32, only_area: bool) -> AreaContact {
     let ob = offset(wall.b_anchor, wall.b_frac, wall.b_rem, s.anchor, s.frac, s.q[0].xy);
     var p: Outline;
     load_outline(i, vec2<i32>(0), vec2<f32>(0.0), &p);
-    var g = polygon_wall(&p, offset_units(oa), offset_units(ob), oa, only_area);
+    var g = polygon_wall(&p, offset_units(oa), offset_units(ob), oa, wall.ab, only_area);
     let u = params.unit;
     g.area *= u * u;
     g.chord *= u;
@@ -713,26 +749,41 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
     if (inside == 0u && cut == 0u && !centre_inside) { return no_contact(); }
     var g = no_contact();
     var towards_disk = vec2<f32>(0.0);
+    var done = false;
     if (inside == 0u && cut == 1u && cut_any == 1u) {
         // A sliver under one face: a segment whose depth is exact from an integer dot
-        // product with the face's normal in Q30.
+        // product with the face's normal in Q30. That normal q is the f32 normal, off
+        // the face's true normal n by a turn beta and a stretch alpha (~6e-8, which half
+        // a diameter out is 3e-8 d): q = (1 + alpha) n + beta t, so
+        // w.n = w.q - beta (w.t) - alpha (w.q), with beta = q.t and 1 + alpha = |q| from
+        // exact integer products (issue 19).
         let a = edge;
         let b = (edge + 1u) % np;
-        let ab = vec2<f32>(p.w[b] - p.w[a]);
-        let t = ab / length(ab);
+        let abi = p.w[b] - p.w[a];
+        let ab = vec2<f32>(abi);
+        let len = length(ab);
+        let t = ab / len;
         let nout = vec2<f32>(t.y, -t.x);         // out of the polygon, towards the disk
         let nq = vec2<i32>(round(nout * Q30));
-        let exact = add64(add64(smul(p.w[a].x, nq.x), smul(p.w[a].y, nq.y)),
-                          vec2<u32>(ru << 30u, ru >> 2u));
-        let delta = i64_to_f32(exact) / Q30 + rr + dot(corner_e(&p, a), nout);
+        let beta = i64_to_f32(add64(smul(nq.x, abi.x), smul(nq.y, abi.y))) / (Q30 * len);
+        let q2 = add64(smul(nq.x, nq.x), smul(nq.y, nq.y));
+        let alpha = 0.5 * i64_to_f32(sub64(q2, vec2<u32>(0u, 0x10000000u))) / (Q30 * Q30);
+        let wq = add64(smul(p.w[a].x, nq.x), smul(p.w[a].y, nq.y));
+        let exact = add64(wq, vec2<u32>(ru << 30u, ru >> 2u));
+        let w_t = dot(vec2<f32>(p.w[a]), t);
+        let delta = i64_to_f32(exact) / Q30 + rr + dot(corner_e(&p, a), nout)
+            - beta * w_t - alpha * i64_to_f32(wq) / Q30;
         if (delta <= 0.0) { return no_contact(); }
         g.area = segment_area(r, delta);
         g.chord = 2.0 * sqrt(max(delta * (2.0 * r - delta), 0.0));
         g.point = -(r - delta) * nout;
         towards_disk = nout;
-    } else if (inside == 1u && cut_any == 0u) {
-        // One corner inside: the triangle it cuts off with the circle plus the segment
-        // beyond the chord, from its exact depth.
+        done = true;
+    }
+    if (!done && inside == 1u && cut_any == 0u) {
+        // One corner inside: the triangle it cuts off with the circle plus the minor
+        // segment beyond the chord, from its exact depth; unless the disk's centre lies
+        // beyond the chord (the rest is then a major segment: the general formula).
         let v = corner_at(&p, corner, vec2<i32>(0));
         let u1 = normalize(corner_at(&p, (corner + np - 1u) % np, vec2<i32>(0)) - v);
         let u2 = normalize(corner_at(&p, (corner + 1u) % np, vec2<i32>(0)) - v);
@@ -743,18 +794,26 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
         if (b1 > 0.0) { s1 = k / (b1 + sqrt(b1 * b1 + k)); }
         var s2 = -b2 + sqrt(b2 * b2 + k);
         if (b2 > 0.0) { s2 = k / (b2 + sqrt(b2 * b2 + k)); }
-        let x1 = v + s1 * u1;
-        let x2 = v + s2 * u2;
-        let chord = sqrt(max(s1 * s1 + s2 * s2 - 2.0 * s1 * s2 * dot(u1, u2), 0.0));
+        // The chord from the corner's own frame: x2 - x1 = s2 u2 - s1 u1, not the
+        // difference of two points half a diameter out, which f32 rounds to ~3e-8 d.
+        let x21 = s2 * u2 - s1 * u1;
+        let chord = length(x21);
         let half = 0.5 * chord;
         let sag = half * half / (r + sqrt(max(r * r - half * half, 0.0)));
-        g.area = 0.5 * s1 * s2 * abs(cross2(u1, u2)) + segment_area(r, sag);
-        g.chord = chord;
-        g.point = 0.5 * (x1 + x2);
-        let tt = (x2 - x1) / max(chord, 1.0e-30);
+        let mid = v + 0.5 * (s1 * u1 + s2 * u2);
+        let tt = x21 / max(chord, 1.0e-30);
         let nn = vec2<f32>(-tt.y, tt.x);
-        towards_disk = nn * select(-1.0, 1.0, dot(nn, -g.point) + dot(nn, v - g.point) > 0.0);
-    } else {
+        let centre_side = dot(nn, -mid);
+        let corner_side = dot(nn, v - mid);
+        if (centre_side * corner_side >= 0.0) {
+            g.area = 0.5 * s1 * s2 * abs(cross2(u1, u2)) + segment_area(r, sag);
+            g.chord = chord;
+            g.point = mid;
+            towards_disk = nn * select(-1.0, 1.0, centre_side + corner_side > 0.0);
+            done = true;
+        }
+    }
+    if (!done) {
         // Deep or unusual: the general formula in f32 (src/overlap.rs `polygon_disk`),
         // the force point between the two crossings of the outlines farthest apart.
         var area = 0.0;

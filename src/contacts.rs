@@ -7,9 +7,10 @@
 //! their circumscribed circles, then kept when their outlines overlap.
 
 use crate::cell_list::{CellList, Grid};
-use crate::geometry::{WallSegment, disk_disk, disk_wall};
+use crate::forces::offset;
+use crate::geometry::{WallSegment, disk_disk, disk_wall, wall_from};
 use crate::overlap::{overlap_area, polygon_disk, polygon_wall};
-use crate::shape::WorldShapes;
+use crate::shape::RotatedCorners;
 use crate::state::Particles;
 
 /// Ids at and above this refer to walls: `WALL_BASE + wall index`.
@@ -29,25 +30,26 @@ impl Pair {
 }
 
 /// Whether particles i and j interact: disks within `range_factor` · σ, polygons whose
-/// circumscribed circles overlap and whose outlines intersect (SPEC 2.3).
+/// circumscribed circles overlap and whose outlines intersect (SPEC 2.3). Like the
+/// forces, computed from the offset of the pair only.
 pub fn interacts(
     particles: &Particles,
-    shapes: &WorldShapes,
+    corners: &RotatedCorners,
     range_factor: f64,
     i: usize,
     j: usize,
 ) -> bool {
-    let pos = &particles.q[0];
-    let (pi, pj) = ([pos[i][0], pos[i][1]], [pos[j][0], pos[j][1]]);
-    let g = disk_disk(pi, particles.radius[i], pj, particles.radius[j]);
+    let d = offset(particles, i, j);
+    let (ri, rj) = (particles.radius[i], particles.radius[j]);
+    let g = disk_disk(d, ri, rj);
     // A NaN distance (a diverged state) interacts with nothing.
     if g.r.is_nan() || g.r >= range_factor * g.sigma {
         return false;
     }
     match (particles.is_polygon(i), particles.is_polygon(j)) {
-        (true, true) => overlap_area(shapes.of(i), pi, shapes.of(j)) > 0.0,
-        (true, false) => polygon_disk(shapes.of(i), pi, pj, particles.radius[j], true).is_some(),
-        (false, true) => polygon_disk(shapes.of(j), pj, pi, particles.radius[i], false).is_some(),
+        (true, true) => overlap_area(corners.of(i), corners.of(j), d) > 0.0,
+        (true, false) => polygon_disk(corners.of(i), d, rj, true).is_some(),
+        (false, true) => polygon_disk(corners.of(j), [-d[0], -d[1]], ri, false).is_some(),
         (false, false) => true,
     }
 }
@@ -55,19 +57,19 @@ pub fn interacts(
 /// Whether particle i touches wall w.
 pub fn touches_wall(
     particles: &Particles,
-    shapes: &WorldShapes,
+    corners: &RotatedCorners,
     range_factor: f64,
     i: usize,
     wall: &WallSegment,
 ) -> bool {
-    let pi = particles.position(i);
-    let g = disk_wall(pi, particles.radius[i], wall);
+    let w = wall_from(wall, particles.position(i));
+    let g = disk_wall(particles.radius[i], &w);
     // A NaN distance (a diverged state) interacts with nothing.
     if g.r.is_nan() || g.r >= range_factor * g.sigma {
         return false;
     }
     if particles.is_polygon(i) {
-        return polygon_wall(shapes.of(i), pi, wall).is_some();
+        return polygon_wall(corners.of(i), &w).is_some();
     }
     true
 }
@@ -78,7 +80,7 @@ pub fn find_contacts(
     grid: &Grid,
     cells: &CellList,
     particles: &Particles,
-    shapes: &WorldShapes,
+    corners: &RotatedCorners,
     walls: &[WallSegment],
     range_factor: f64,
     out: &mut Vec<Pair>,
@@ -99,7 +101,7 @@ pub fn find_contacts(
                     if ju <= i || (particles.fixed[i] && particles.fixed[ju]) {
                         continue;
                     }
-                    if interacts(particles, shapes, range_factor, i, ju) {
+                    if interacts(particles, corners, range_factor, i, ju) {
                         out.push(Pair { i: i as u32, j });
                     }
                 }
@@ -112,7 +114,7 @@ pub fn find_contacts(
             continue;
         }
         for (w, wall) in walls.iter().enumerate() {
-            if touches_wall(particles, shapes, range_factor, i, wall) {
+            if touches_wall(particles, corners, range_factor, i, wall) {
                 out.push(Pair {
                     i: i as u32,
                     j: WALL_BASE + w as u32,
@@ -125,7 +127,7 @@ pub fn find_contacts(
 /// Reference O(N²) search used by tests to check `find_contacts`.
 pub fn brute_force_contacts(
     particles: &Particles,
-    shapes: &WorldShapes,
+    corners: &RotatedCorners,
     walls: &[WallSegment],
     range_factor: f64,
 ) -> Vec<Pair> {
@@ -138,7 +140,7 @@ pub fn brute_force_contacts(
             if !particles.active[j] || (particles.fixed[i] && particles.fixed[j]) {
                 continue;
             }
-            if interacts(particles, shapes, range_factor, i, j) {
+            if interacts(particles, corners, range_factor, i, j) {
                 out.push(Pair {
                     i: i as u32,
                     j: j as u32,
@@ -149,7 +151,7 @@ pub fn brute_force_contacts(
             continue;
         }
         for (w, wall) in walls.iter().enumerate() {
-            if touches_wall(particles, shapes, range_factor, i, wall) {
+            if touches_wall(particles, corners, range_factor, i, wall) {
                 out.push(Pair {
                     i: i as u32,
                     j: WALL_BASE + w as u32,

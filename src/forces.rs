@@ -8,10 +8,14 @@
 //! the sum never depends on thread timing (no float atomics).
 
 use crate::contacts::{Pair, WALL_BASE};
-use crate::geometry::{Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent};
+use crate::geometry::{
+    Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent, wall_from,
+};
 use crate::law::{ContactInput, ContactLaw};
-use crate::overlap::{disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall};
-use crate::shape::WorldShapes;
+use crate::overlap::{
+    AreaContact, disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall,
+};
+use crate::shape::RotatedCorners;
 use crate::state::{Dof, Particles};
 
 /// The result of one contact, kept for outputs and the reduction.
@@ -19,8 +23,11 @@ use crate::state::{Dof, Particles};
 pub struct ContactForce {
     /// Total force on particle i (−force acts on j).
     pub force: [f64; 2],
-    /// Contact point, where both forces act.
+    /// Contact point, where both forces act (world coordinates, for outputs).
     pub point: [f64; 2],
+    /// The contact point relative to particle i's centre: the branch vector the torques
+    /// use (relative to j's centre it is `arm + r_i − r_j`).
+    pub arm: [f64; 2],
     /// Normal (from j to i) and the normal and tangential components.
     pub n: [f64; 2],
     pub f_n: f64,
@@ -34,7 +41,7 @@ pub struct ContactForce {
 /// Stage: forces of every contact, and the updated tangential history.
 pub fn contact_forces(
     particles: &Particles,
-    shapes: &WorldShapes,
+    corners: &RotatedCorners,
     walls: &[WallSegment],
     law: &ContactLaw,
     dt: f64,
@@ -47,16 +54,18 @@ pub fn contact_forces(
     history_out.clear();
     for (&pair, &history) in pairs.iter().zip(history_in) {
         let area = matches!(law, ContactLaw::OverlapArea(_));
-        let (g, input) = contact_input(particles, shapes, walls, dt, area, pair, history);
+        let (g, input) = contact_input(particles, corners, walls, dt, area, pair, history);
         let res = law.evaluate(&input);
         let t = tangent(g.n);
         let force = [
             res.f_n * g.n[0] + res.f_t * t[0],
             res.f_n * g.n[1] + res.f_t * t[1],
         ];
+        let p = particles.position(pair.i as usize);
         out.push(ContactForce {
             force,
-            point: g.point,
+            point: [p[0] + g.arm[0], p[1] + g.arm[1]],
+            arm: g.arm,
             n: g.n,
             f_n: res.f_n,
             f_t: res.f_t,
@@ -67,11 +76,19 @@ pub fn contact_forces(
     }
 }
 
-/// Geometry and kinematics of one contact: what the law needs.
+/// r_i − r_j: the offset of the pair, the only way positions enter a contact's geometry
+/// (issue 18).
+pub fn offset(particles: &Particles, i: usize, j: usize) -> [f64; 2] {
+    let (pi, pj) = (particles.position(i), particles.position(j));
+    [pi[0] - pj[0], pi[1] - pj[1]]
+}
+
+/// Geometry and kinematics of one contact: what the law needs. The geometry is in a
+/// frame at particle i's centre (`Geometry::arm`).
 /// `area`: the overlap-area law, which sees every pair (disks too) by its overlap area.
 pub fn contact_input(
     particles: &Particles,
-    shapes: &WorldShapes,
+    corners: &RotatedCorners,
     walls: &[WallSegment],
     dt: f64,
     area: bool,
@@ -80,43 +97,23 @@ pub fn contact_input(
 ) -> (Geometry, ContactInput) {
     let i = pair.i as usize;
     if area {
-        return area_contact_input(particles, shapes, walls, dt, pair, history);
+        return area_contact_input(particles, corners, walls, dt, pair, history);
     }
-    let p1 = particles.position(i);
     let v1 = particles.velocity(i, dt);
-    let (g, v2, w2, m2) = if pair.is_wall() {
+    let (g, d) = if pair.is_wall() {
         let wall = &walls[(pair.j - WALL_BASE) as usize];
-        (
-            disk_wall(p1, particles.radius[i], wall),
-            [0.0, 0.0],
-            0.0,
-            f64::INFINITY,
-        )
+        let w = wall_from(wall, particles.position(i));
+        (disk_wall(particles.radius[i], &w), None)
     } else {
         let j = pair.j as usize;
-        let v = particles.velocity(j, dt);
-        (
-            disk_disk(
-                p1,
-                particles.radius[i],
-                particles.position(j),
-                particles.radius[j],
-            ),
-            [v[0], v[1]],
-            v[2],
-            particles.mass[j],
-        )
+        let d = offset(particles, i, j);
+        let g = disk_disk(d, particles.radius[i], particles.radius[j]);
+        (g, Some(d))
     };
-    let l1 = [g.point[0] - p1[0], g.point[1] - p1[1]];
-    let s1 = spin_velocity(v1[2], l1);
-    let s2 = if pair.is_wall() {
-        [0.0, 0.0]
-    } else {
-        let p2 = particles.position(pair.j as usize);
-        spin_velocity(w2, [g.point[0] - p2[0], g.point[1] - p2[1]])
-    };
+    let s1 = spin_velocity(v1[2], g.arm);
+    let (v2, m2) = material_velocity(particles, dt, pair, g.arm, d);
     // Relative velocity of the two surfaces at the contact point (rotation included).
-    let v12 = [v1[0] + s1[0] - v2[0] - s2[0], v1[1] + s1[1] - v2[1] - s2[1]];
+    let v12 = [v1[0] + s1[0] - v2[0], v1[1] + s1[1] - v2[1]];
     let t = tangent(g.n);
     let m1 = particles.mass[i];
     let (m12, mass) = if m2.is_infinite() {
@@ -139,16 +136,53 @@ pub fn contact_input(
     (g, input)
 }
 
-/// Velocity of particle j's material at the point x (zero for a wall), and its mass.
-fn material_velocity(particles: &Particles, dt: f64, pair: Pair, x: [f64; 2]) -> ([f64; 2], f64) {
-    if pair.is_wall() {
+/// Velocity of particle j's material at the contact point (zero for a wall), and its
+/// mass. The point is `arm` from r_i, so `arm + d` from r_j (d = r_i − r_j).
+fn material_velocity(
+    particles: &Particles,
+    dt: f64,
+    pair: Pair,
+    arm: [f64; 2],
+    d: Option<[f64; 2]>,
+) -> ([f64; 2], f64) {
+    let (false, Some(d)) = (pair.is_wall(), d) else {
         return ([0.0, 0.0], f64::INFINITY);
-    }
+    };
     let j = pair.j as usize;
     let v = particles.velocity(j, dt);
-    let p = particles.position(j);
-    let s = spin_velocity(v[2], [x[0] - p[0], x[1] - p[1]]);
+    let s = spin_velocity(v[2], [arm[0] + d[0], arm[1] + d[1]]);
     ([v[0] + s[0], v[1] + s[1]], particles.mass[j])
+}
+
+/// The overlap-area geometry of a pair (SPEC 2.3), whatever the shapes, in the frame of
+/// i's centre; None when they do not overlap.
+pub fn area_contact(
+    particles: &Particles,
+    corners: &RotatedCorners,
+    walls: &[WallSegment],
+    pair: Pair,
+) -> Option<AreaContact> {
+    let i = pair.i as usize;
+    let (ri, poly_i) = (particles.radius[i], particles.is_polygon(i));
+    if pair.is_wall() {
+        let wall = &walls[(pair.j - WALL_BASE) as usize];
+        let w = wall_from(wall, particles.position(i));
+        return if poly_i {
+            polygon_wall(corners.of(i), &w)
+        } else {
+            disk_wall_area(ri, &w)
+        };
+    }
+    let j = pair.j as usize;
+    let d = offset(particles, i, j);
+    let rj = particles.radius[j];
+    match (poly_i, particles.is_polygon(j)) {
+        (true, true) => polygon_polygon(corners.of(i), corners.of(j), d),
+        // The polygon's centre relative to the disk's.
+        (true, false) => polygon_disk(corners.of(i), d, rj, true),
+        (false, true) => polygon_disk(corners.of(j), [-d[0], -d[1]], ri, false),
+        (false, false) => disk_disk_area(d, ri, rj),
+    }
 }
 
 /// Geometry and kinematics of a polygon contact (SPEC 2.3, src/law/overlap_area.rs): the
@@ -157,36 +191,18 @@ fn material_velocity(particles: &Particles, dt: f64, pair: Pair, x: [f64; 2]) ->
 /// gives zero input.
 fn area_contact_input(
     particles: &Particles,
-    shapes: &WorldShapes,
+    corners: &RotatedCorners,
     walls: &[WallSegment],
     dt: f64,
     pair: Pair,
     history: f64,
 ) -> (Geometry, ContactInput) {
     let i = pair.i as usize;
-    let p1 = particles.position(i);
-    let (ri, poly_i) = (particles.radius[i], particles.is_polygon(i));
-    let c = if pair.is_wall() {
-        let wall = &walls[(pair.j - WALL_BASE) as usize];
-        if poly_i {
-            polygon_wall(shapes.of(i), p1, wall)
-        } else {
-            disk_wall_area(p1, ri, wall)
-        }
-    } else {
-        let j = pair.j as usize;
-        let p2 = particles.position(j);
-        match (poly_i, particles.is_polygon(j)) {
-            (true, true) => polygon_polygon(shapes.of(i), p1, shapes.of(j), p2),
-            (true, false) => polygon_disk(shapes.of(i), p1, p2, particles.radius[j], true),
-            (false, true) => polygon_disk(shapes.of(j), p2, p1, ri, false),
-            (false, false) => disk_disk_area(p1, ri, p2, particles.radius[j]),
-        }
-    }
-    .unwrap_or_default();
+    let c = area_contact(particles, corners, walls, pair).unwrap_or_default();
+    let d = (!pair.is_wall()).then(|| offset(particles, i, pair.j as usize));
     let v1 = particles.velocity(i, dt);
-    let s1 = spin_velocity(v1[2], [c.point[0] - p1[0], c.point[1] - p1[1]]);
-    let (v2, m2) = material_velocity(particles, dt, pair, c.point);
+    let s1 = spin_velocity(v1[2], c.arm);
+    let (v2, m2) = material_velocity(particles, dt, pair, c.arm, d);
     let v12 = [v1[0] + s1[0] - v2[0], v1[1] + s1[1] - v2[1]];
     let t = tangent(c.n);
     let m1 = particles.mass[i];
@@ -220,7 +236,7 @@ fn area_contact_input(
         delta,
         r: depth,
         sigma: 0.0,
-        point: c.point,
+        arm: c.arm,
     };
     (g, input)
 }
@@ -236,18 +252,17 @@ pub fn reduce_forces(
     out.resize(particles.len(), [0.0; 3]);
     for (pair, c) in pairs.iter().zip(contacts) {
         let i = pair.i as usize;
-        let pi = particles.position(i);
         let acc = &mut out[i];
         acc[0] += c.force[0];
         acc[1] += c.force[1];
-        acc[2] += cross([c.point[0] - pi[0], c.point[1] - pi[1]], c.force);
+        acc[2] += cross(c.arm, c.force);
         if !pair.is_wall() {
             let j = pair.j as usize;
-            let pj = particles.position(j);
+            let d = offset(particles, i, j);
             let acc = &mut out[j];
             acc[0] -= c.force[0];
             acc[1] -= c.force[1];
-            acc[2] -= cross([c.point[0] - pj[0], c.point[1] - pj[1]], c.force);
+            acc[2] -= cross([c.arm[0] + d[0], c.arm[1] + d[1]], c.force);
         }
     }
 }

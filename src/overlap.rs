@@ -10,6 +10,17 @@
 //! corners and n along the line of centres; more than two crossings (nearly parallel
 //! edges) take the two that are farthest apart, which spans the thin overlap along its
 //! length.
+//!
+//! **Frames (issue 18).** Every function works in a frame at particle i's centre: its
+//! corners relative to its centre (`shape::rotate`), the other particle through the
+//! offset d = r_i − r_j, a wall through its end points relative to r_i
+//! (`geometry::wall_from`). Absolute world coordinates never enter: on coordinates of
+//! size X, the crossings would carry X ε and the shoelace area X² ε, which at X = 100 d
+//! is more than a resting overlap's whole area. The area is then summed about the
+//! overlap's own first corner (`shape::area`), so a sliver 1e-6 d deep keeps ~1e-10 of
+//! relative precision. The results are in the same frame: `arm` is the force point
+//! relative to r_i. The clipping follows `shaders/polygon.wgsl` step for step: each
+//! corner of the clipped polygon remembers the line its outgoing edge lies on.
 
 use crate::geometry::{WallSegment, cross};
 use crate::shape::{MAX_CORNERS, P2};
@@ -17,50 +28,69 @@ use crate::shape::{MAX_CORNERS, P2};
 /// Most corners an overlap polygon can have: each clipping half-plane adds at most one.
 pub const MAX_CLIP: usize = 2 * MAX_CORNERS as usize + 4;
 
-/// A convex polygon of at most [`MAX_CLIP`] corners, held on the stack (the overlap is
-/// computed for every contact every step; no allocation).
+/// Line ids of the clipping: edge m of p (corner m to m + 1) is m, edge m of q is
+/// `Q_LINE + m`; then a wall's line and the lines across its two ends (as in
+/// polygon.wgsl).
+pub const Q_LINE: u32 = MAX_CORNERS;
+pub const WALL_LINE: u32 = 2 * MAX_CORNERS;
+pub const END_A_LINE: u32 = WALL_LINE + 1;
+pub const END_B_LINE: u32 = WALL_LINE + 2;
+
+/// A convex polygon being clipped, on the stack (the overlap is computed for every
+/// contact every step; no allocation): its corners and, for each, the line of its
+/// outgoing edge (corner k to k + 1).
 #[derive(Clone, Copy, Debug)]
-pub struct Poly {
+pub struct Clip {
     pub n: usize,
     pub v: [P2; MAX_CLIP],
+    pub line: [u32; MAX_CLIP],
 }
 
-impl Default for Poly {
+impl Default for Clip {
     fn default() -> Self {
         Self {
             n: 0,
             v: [[0.0; 2]; MAX_CLIP],
+            line: [0; MAX_CLIP],
         }
     }
 }
 
-impl Poly {
-    pub fn from_slice(p: &[P2]) -> Self {
-        let mut out = Self::default();
-        out.v[..p.len()].copy_from_slice(p);
-        out.n = p.len();
-        out
+impl Clip {
+    /// A polygon's outline: edge k on line `first_line + k`.
+    fn outline(p: &[P2], first_line: u32) -> Self {
+        let mut c = Self::default();
+        for (k, x) in p.iter().enumerate() {
+            c.push(*x, first_line + k as u32);
+        }
+        c
     }
 
     pub fn corners(&self) -> &[P2] {
         &self.v[..self.n]
     }
 
-    fn push(&mut self, x: P2) {
+    /// The lines of the edges into and out of corner k.
+    fn lines_at(&self, k: usize) -> (u32, u32) {
+        (self.line[(k + self.n - 1) % self.n], self.line[k])
+    }
+
+    fn push(&mut self, x: P2, line: u32) {
         self.v[self.n] = x;
+        self.line[self.n] = line;
         self.n += 1;
     }
 }
 
-/// The geometry of one area contact, seen from particle i.
+/// The geometry of one area contact, seen from particle i, in a frame at its centre.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AreaContact {
     /// Overlap area A.
     pub area: f64,
     /// Unit normal from j to i, perpendicular to the intersection line.
     pub n: P2,
-    /// Force point S: the midpoint of the intersection line.
-    pub point: P2,
+    /// Force point S relative to r_i: the midpoint of the intersection line.
+    pub arm: P2,
     /// Length L of the intersection line (0 in the degenerate fallback).
     pub chord: f64,
     /// l = 1/(1/l_i + 1/l_j), l_i = |S − r_i| (paper 000 eq. 6); l_i alone for a wall.
@@ -79,44 +109,30 @@ fn norm(a: P2) -> f64 {
     dot(a, a).sqrt()
 }
 
-/// One Sutherland–Hodgman step: the part of the convex polygon `poly` in the half-plane
-/// {x : (x − a)·m ≥ 0}.
-pub fn clip_half_plane(poly: &[P2], a: P2, m: P2, out: &mut Poly) {
-    out.n = 0;
-    let n = poly.len();
-    for k in 0..n {
-        let (p, q) = (poly[k], poly[(k + 1) % n]);
-        let (dp, dq) = (dot(sub(p, a), m), dot(sub(q, a), m));
-        if dp >= 0.0 {
-            out.push(p);
+/// One Sutherland–Hodgman step (`clip_lines` in polygon.wgsl): the part of `src` in
+/// the half-plane {x : (x − a)·m ≥ 0}, whose boundary is line `id`. Leaving the
+/// half-plane the outline follows the clip line, entering it the edge it was on.
+fn clip_lines(src: &Clip, a: P2, m: P2, id: u32, dst: &mut Clip) {
+    dst.n = 0;
+    let n = src.n;
+    for e in 0..n {
+        let (x, y) = (src.v[e], src.v[(e + 1) % n]);
+        let (dx, dy) = (dot(sub(x, a), m), dot(sub(y, a), m));
+        if dx >= 0.0 {
+            dst.push(x, src.line[e]);
         }
-        if (dp >= 0.0) != (dq >= 0.0) {
-            let t = dp / (dp - dq);
-            out.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+        if (dx >= 0.0) != (dy >= 0.0) {
+            let t = dx / (dx - dy);
+            let at = [x[0] + t * (y[0] - x[0]), x[1] + t * (y[1] - x[1])];
+            dst.push(at, if dx >= 0.0 { id } else { src.line[e] });
         }
     }
-}
-
-/// The overlap polygon of two convex, counter-clockwise polygons: p clipped by every
-/// edge of q (p's centre ci speeds it up; see `tagged_intersection`).
-pub fn intersection(p: &[P2], ci: P2, q: &[P2]) -> Poly {
-    tagged_intersection(p, ci, q).poly
-}
-
-/// Whether two convex polygons overlap with positive area (the contact test of the
-/// broad phase's survivors; the same clipping as [`polygon_polygon`]).
-pub fn overlap_area(p: &[P2], ci: P2, q: &[P2]) -> f64 {
-    let o = intersection(p, ci, q);
-    if o.n < 3 {
-        return 0.0;
-    }
-    crate::shape::area(o.corners())
 }
 
 /// Where a corner of the overlap polygon comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Origin {
-    /// A corner of p inside q.
+    /// A corner of p inside q (two of p's edges meet).
     P,
     /// A corner of q inside p (two of q's edge lines meet).
     Q,
@@ -124,88 +140,68 @@ enum Origin {
     Crossing,
 }
 
-/// The overlap polygon with the origin of each corner: p clipped by every edge of q,
-/// remembering for each edge of the clipped polygon whether it lies on p's outline. A
-/// new corner on such an edge is a crossing of the outlines; one on an edge of q's
-/// lines is a corner of q. The crossings come out of the clipping, with no extra search.
-struct Tagged {
-    poly: Poly,
-    origin: [Origin; MAX_CLIP],
-    on_p: [bool; MAX_CLIP],
-}
-
-impl Tagged {
-    fn push(&mut self, x: P2, origin: Origin, on_p: bool) {
-        let n = self.poly.n;
-        self.poly.v[n] = x;
-        self.origin[n] = origin;
-        self.on_p[n] = on_p;
-        self.poly.n += 1;
+fn origin_of(line_in: u32, line_out: u32) -> Origin {
+    match (line_in < Q_LINE, line_out < Q_LINE) {
+        (true, true) => Origin::P,
+        (false, false) => Origin::Q,
+        _ => Origin::Crossing,
     }
 }
 
-fn tagged_intersection(p: &[P2], ci: P2, q: &[P2]) -> Tagged {
-    let empty = || Tagged {
-        poly: Poly::default(),
-        origin: [Origin::P; MAX_CLIP],
-        on_p: [true; MAX_CLIP],
-    };
-    let mut buf = [empty(), empty()];
-    buf[0].poly = Poly::from_slice(p);
+/// Particle j's corners (relative to r_j) in i's frame, d = r_i − r_j.
+fn in_frame_of_i(q: &[P2], d: P2) -> ([P2; MAX_CORNERS as usize], usize) {
+    let mut out = [[0.0; 2]; MAX_CORNERS as usize];
+    for (o, x) in out.iter_mut().zip(q) {
+        *o = sub(*x, d);
+    }
+    (out, q.len())
+}
+
+/// The overlap polygon: p (centred on the origin) clipped by the edges of q, both
+/// convex and counter-clockwise in i's frame. The lines of the clipped polygon's edges
+/// tell where each of its corners comes from; the crossings come out of the clipping,
+/// with no extra search.
+fn clip_by(p: &[P2], q: &[P2]) -> Clip {
+    let mut buf = [Clip::outline(p, 0), Clip::default()];
     let mut cur = 0;
-    // p lies in the circle of radius r about ci: an edge line of q that keeps the whole
-    // circle inside clips nothing, one that keeps it all outside leaves no overlap. Only
-    // the few edges near the contact are clipped.
-    let r = p
-        .iter()
-        .map(|v| dot(sub(*v, ci), sub(*v, ci)))
-        .fold(0.0, f64::max)
-        .sqrt();
+    // p lies in the circle of radius r about its centre: an edge line of q that keeps
+    // the whole circle inside clips nothing, one that keeps it all outside leaves no
+    // overlap. Only the few edges near the contact are clipped.
+    let r = p.iter().map(|v| dot(*v, *v)).fold(0.0, f64::max).sqrt();
     let nq = q.len();
     for k in 0..nq {
         let (a, b) = (q[k], q[(k + 1) % nq]);
         let m = [-(b[1] - a[1]), b[0] - a[0]];
         let reach = r * norm(m);
-        let centre = dot(sub(ci, a), m);
+        let centre = -dot(a, m);
         if centre >= reach {
             continue;
         }
         if centre <= -reach {
-            buf[cur].poly.n = 0;
+            buf[cur].n = 0;
             break;
         }
-        let (src, dst) = if cur == 0 {
-            let (x, y) = buf.split_at_mut(1);
-            (&x[0], &mut y[0])
-        } else {
-            let (x, y) = buf.split_at_mut(1);
-            (&y[0], &mut x[0])
-        };
-        dst.poly.n = 0;
-        let n = src.poly.n;
-        for e in 0..n {
-            let (x, y) = (src.poly.v[e], src.poly.v[(e + 1) % n]);
-            let (dx, dy) = (dot(sub(x, a), m), dot(sub(y, a), m));
-            let on_p = src.on_p[e];
-            if dx >= 0.0 {
-                dst.push(x, src.origin[e], on_p);
-            }
-            if (dx >= 0.0) != (dy >= 0.0) {
-                let t = dx / (dx - dy);
-                let at = [x[0] + t * (y[0] - x[0]), x[1] + t * (y[1] - x[1])];
-                let origin = if on_p { Origin::Crossing } else { Origin::Q };
-                // Leaving the half-plane the polygon follows q's line; entering it, the
-                // edge it was on.
-                dst.push(at, origin, if dx >= 0.0 { false } else { on_p });
-            }
-        }
+        let [x, y] = &mut buf;
+        let (src, dst) = if cur == 0 { (&*x, y) } else { (&*y, x) };
+        clip_lines(src, a, m, Q_LINE + k as u32, dst);
         cur = 1 - cur;
-        if buf[cur].poly.n == 0 {
+        if buf[cur].n == 0 {
             break;
         }
     }
-    let [a, b] = buf;
-    if cur == 0 { a } else { b }
+    buf[cur]
+}
+
+/// The overlap area of polygons p (corners relative to r_i) and q (relative to r_j),
+/// d = r_i − r_j: the contact test of the broad phase's survivors, by the same clipping
+/// as [`polygon_polygon`].
+pub fn overlap_area(p: &[P2], q: &[P2], d: P2) -> f64 {
+    let (q, nq) = in_frame_of_i(q, d);
+    let o = clip_by(p, &q[..nq]);
+    if o.n < 3 {
+        return 0.0;
+    }
+    crate::shape::area(o.corners())
 }
 
 /// Mean of the corners: the fallback force point. Unlike the area centroid it needs no
@@ -238,33 +234,43 @@ fn reduced_arm(li: f64, lj: f64, scale: f64) -> f64 {
     li * lj / (li + lj)
 }
 
-/// Area contact of polygon p (particle i, centre ci) with polygon q (particle j, centre
-/// cj), both convex and counter-clockwise in world coordinates; None when the outlines
-/// do not overlap.
-pub fn polygon_polygon(p: &[P2], ci: P2, q: &[P2], cj: P2) -> Option<AreaContact> {
-    let tagged = tagged_intersection(p, ci, q);
-    if tagged.poly.n < 3 {
+/// The unit vector along d, or +z for d = 0.
+fn unit_or_up(d: P2) -> P2 {
+    let l = norm(d);
+    if l > 0.0 {
+        [d[0] / l, d[1] / l]
+    } else {
+        [0.0, 1.0]
+    }
+}
+
+/// Area contact of polygon p (particle i) with polygon q (particle j): corners relative
+/// to their own centres, both convex and counter-clockwise, d = r_i − r_j. None when
+/// the outlines do not overlap.
+pub fn polygon_polygon(p: &[P2], q: &[P2], d: P2) -> Option<AreaContact> {
+    let (qi, nq) = in_frame_of_i(q, d);
+    let clip = clip_by(p, &qi[..nq]);
+    if clip.n < 3 {
         return None;
     }
-    let overlap = tagged.poly.corners();
+    let overlap = clip.corners();
     let area = crate::shape::area(overlap);
     if area <= 0.0 {
         return None;
     }
-    let mut crossed = Poly::default();
+    let origin = |k: usize| {
+        let (lin, lout) = clip.lines_at(k);
+        origin_of(lin, lout)
+    };
+    let mut crossed = Clip::default();
     for (k, x) in overlap.iter().enumerate() {
-        if tagged.origin[k] == Origin::Crossing {
-            crossed.push(*x);
+        if origin(k) == Origin::Crossing {
+            crossed.push(*x, 0);
         }
     }
     let xs = crossed.corners();
-    let scale = norm(sub(ci, cj)) + norm(sub(p[0], ci)) + norm(sub(q[0], cj));
-    let centres = sub(ci, cj);
-    let along_centres = if norm(centres) > 0.0 {
-        [centres[0] / norm(centres), centres[1] / norm(centres)]
-    } else {
-        [0.0, 1.0]
-    };
+    let scale = norm(d) + norm(p[0]) + norm(q[0]);
+    let along_centres = unit_or_up(d);
     let (n, point, chord) = if xs.len() >= 2 {
         let (a, b) = farthest_pair(xs);
         let chord = norm(sub(b, a));
@@ -277,13 +283,13 @@ pub fn polygon_polygon(p: &[P2], ci: P2, q: &[P2], cj: P2) -> Option<AreaContact
             let side: f64 = overlap
                 .iter()
                 .enumerate()
-                .map(|(k, x)| match tagged.origin[k] {
+                .map(|(k, x)| match origin(k) {
                     Origin::P => dot(n, sub(*x, s)),
                     Origin::Q => -dot(n, sub(*x, s)),
                     Origin::Crossing => 0.0,
                 })
                 .sum();
-            if side > 0.0 || (side == 0.0 && dot(n, centres) < 0.0) {
+            if side > 0.0 || (side == 0.0 && dot(n, d) < 0.0) {
                 n = [-n[0], -n[1]];
             }
             (n, s, chord)
@@ -293,64 +299,69 @@ pub fn polygon_polygon(p: &[P2], ci: P2, q: &[P2], cj: P2) -> Option<AreaContact
     } else {
         (along_centres, corner_mean(overlap), 0.0)
     };
-    let l = reduced_arm(norm(sub(point, ci)), norm(sub(point, cj)), scale);
+    // S − r_j = S + d.
+    let l = reduced_arm(norm(point), norm([point[0] + d[0], point[1] + d[1]]), scale);
     Some(AreaContact {
         area,
         n,
-        point,
+        arm: point,
         chord,
         l,
     })
 }
 
-/// Area contact of polygon p (centre ci) with a wall segment: the part of p beyond the
-/// wall's line (seen from the centre) and between its end points. The intersection line
-/// is the stretch of the wall's line inside p; n is the wall's normal towards the centre;
+/// Area contact of polygon p (corners relative to its centre) with a wall segment given
+/// relative to the same centre (`geometry::wall_from`): the part of p beyond the wall's
+/// line (seen from the centre) and between its end points. The intersection line is
+/// the stretch of the wall's line inside p: the overlap corners on the wall's line, known
+/// from the clipping (not by a tolerance). n is the wall's normal towards the centre;
 /// l = l_i (a wall is infinitely large).
-pub fn polygon_wall(p: &[P2], ci: P2, w: &WallSegment) -> Option<AreaContact> {
+pub fn polygon_wall(p: &[P2], w: &WallSegment) -> Option<AreaContact> {
     let ab = sub(w.b, w.a);
     let len = norm(ab);
     if len == 0.0 {
         return None;
     }
     let mut m = [-ab[1] / len, ab[0] / len];
-    if dot(m, sub(ci, w.a)) < 0.0 {
+    if dot(m, w.a) > 0.0 {
         m = [-m[0], -m[1]];
     }
-    let mut cur = Poly::default();
-    let mut next = Poly::default();
-    clip_half_plane(p, w.a, [-m[0], -m[1]], &mut cur);
-    clip_half_plane(cur.corners(), w.a, ab, &mut next);
-    clip_half_plane(next.corners(), w.b, [-ab[0], -ab[1]], &mut cur);
-    if cur.n < 3 {
+    let mut cur = Clip::outline(p, 0);
+    let mut next = Clip::default();
+    clip_lines(&cur, w.a, [-m[0], -m[1]], WALL_LINE, &mut next);
+    clip_lines(&next, w.a, ab, END_A_LINE, &mut cur);
+    clip_lines(&cur, w.b, [-ab[0], -ab[1]], END_B_LINE, &mut next);
+    if next.n < 3 {
         return None;
     }
-    let cur = cur.corners();
-    let area = crate::shape::area(cur);
+    let clip = next;
+    let area = crate::shape::area(clip.corners());
     if area <= 0.0 {
         return None;
     }
-    // Overlap corners on the wall's line: the crossing points (or a wall end inside p).
-    let scale = len + norm(sub(p[0], ci));
-    let on_line = |x: &P2| dot(sub(*x, w.a), m).abs() <= 1e-12 * scale;
+    // Overlap corners on the wall's line: the crossings (or a wall end inside p).
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
-    for x in cur.iter().filter(|x| on_line(x)) {
-        let s = dot(sub(*x, w.a), ab) / len;
-        lo = lo.min(s);
-        hi = hi.max(s);
+    for k in 0..clip.n {
+        let (lin, lout) = clip.lines_at(k);
+        if lin == WALL_LINE || lout == WALL_LINE {
+            let s = dot(sub(clip.v[k], w.a), ab) / len;
+            lo = lo.min(s);
+            hi = hi.max(s);
+        }
     }
     let (point, chord) = if hi > lo {
         let s = 0.5 * (lo + hi) / len;
         ([w.a[0] + s * ab[0], w.a[1] + s * ab[1]], hi - lo)
     } else {
-        (corner_mean(cur), 0.0)
+        (corner_mean(clip.corners()), 0.0)
     };
-    let l = norm(sub(point, ci)).max(1e-9 * scale);
+    let scale = len + norm(p[0]);
+    let l = norm(point).max(1e-9 * scale);
     Some(AreaContact {
         area,
         n: m,
-        point,
+        arm: point,
         chord,
         l,
     })
@@ -359,6 +370,21 @@ pub fn polygon_wall(p: &[P2], ci: P2, w: &WallSegment) -> Option<AreaContact> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn relative(v: &[P2], c: P2) -> Vec<P2> {
+        v.iter().map(|x| sub(*x, c)).collect()
+    }
+
+    /// The contact of two polygons given in world coordinates, and its force point there.
+    fn world_pp(p: &[P2], ci: P2, q: &[P2], cj: P2) -> Option<(AreaContact, P2)> {
+        polygon_polygon(&relative(p, ci), &relative(q, cj), sub(ci, cj))
+            .map(|g| (g, [ci[0] + g.arm[0], ci[1] + g.arm[1]]))
+    }
+
+    fn world_pw(p: &[P2], ci: P2, w: &WallSegment) -> Option<(AreaContact, P2)> {
+        polygon_wall(&relative(p, ci), &crate::geometry::wall_from(w, ci))
+            .map(|g| (g, [ci[0] + g.arm[0], ci[1] + g.arm[1]]))
+    }
 
     fn square(c: P2, half: f64) -> Vec<P2> {
         vec![
@@ -373,7 +399,7 @@ mod tests {
     fn two_unit_squares_offset() {
         // Unit squares, j at the origin, i shifted by (0.9, 0.3): overlap 0.1 × 0.7.
         let (ci, cj) = ([0.9, 0.3], [0.0, 0.0]);
-        let g = polygon_polygon(&square(ci, 0.5), ci, &square(cj, 0.5), cj).unwrap();
+        let (g, point) = world_pp(&square(ci, 0.5), ci, &square(cj, 0.5), cj).unwrap();
         assert!((g.area - 0.07).abs() < 1e-14);
         // Crossings at (0.4, 0.5) (i's left edge, j's top) and (0.5, -0.2) (j's right
         // edge, i's bottom): the line joins them.
@@ -381,9 +407,9 @@ mod tests {
         let tn = norm(t);
         assert!((dot(g.n, [t[0] / tn, t[1] / tn])).abs() < 1e-14, "n ⊥ line");
         assert!(g.n[0] > 0.0, "n points from j to i");
-        assert!((g.point[0] - 0.45).abs() < 1e-14 && (g.point[1] - 0.15).abs() < 1e-14);
+        assert!((point[0] - 0.45).abs() < 1e-14 && (point[1] - 0.15).abs() < 1e-14);
         assert!((g.chord - tn).abs() < 1e-14);
-        let (li, lj) = (norm(sub(g.point, ci)), norm(sub(g.point, cj)));
+        let (li, lj) = (norm(sub(point, ci)), norm(sub(point, cj)));
         assert!((g.l - li * lj / (li + lj)).abs() < 1e-15);
     }
 
@@ -395,12 +421,12 @@ mod tests {
         let ci = [0.0, 0.6333333333333333];
         let sq = vec![[-2.0, -1.0], [2.0, -1.0], [2.0, 0.0], [-2.0, 0.0]];
         let cj = [0.0, -0.5];
-        let g = polygon_polygon(&tri, ci, &sq, cj).unwrap();
+        let (g, point) = world_pp(&tri, ci, &sq, cj).unwrap();
         // Sides through the apex have slope 1.1: the crossings are at x = ±0.1/1.1.
         let half = 0.1 / 1.1;
         assert!((g.area - half * 0.1).abs() < 1e-15);
         assert!((g.n[0]).abs() < 1e-15 && (g.n[1] - 1.0).abs() < 1e-15);
-        assert!(g.point[0].abs() < 1e-15 && g.point[1].abs() < 1e-15);
+        assert!(point[0].abs() < 1e-15 && point[1].abs() < 1e-15);
         assert!((g.chord - 2.0 * half).abs() < 1e-15);
     }
 
@@ -411,7 +437,7 @@ mod tests {
         let ci = [0.0, h - 0.1];
         let diamond = vec![[0.0, -0.1], [h, ci[1]], [0.0, ci[1] + h], [-h, ci[1]]];
         let cj = [0.0, -0.5];
-        let g = polygon_polygon(&diamond, ci, &square(cj, 0.5), cj).unwrap();
+        let (g, _) = world_pp(&diamond, ci, &square(cj, 0.5), cj).unwrap();
         assert!(
             (g.area - 0.01).abs() < 1e-15,
             "a right triangle of legs 0.1√2"
@@ -423,9 +449,9 @@ mod tests {
     #[test]
     fn separated_and_touching_polygons_have_no_contact() {
         let (ci, cj) = ([1.5, 0.0], [0.0, 0.0]);
-        assert!(polygon_polygon(&square(ci, 0.5), ci, &square(cj, 0.5), cj).is_none());
+        assert!(world_pp(&square(ci, 0.5), ci, &square(cj, 0.5), cj).is_none());
         let ci = [1.0, 0.0];
-        assert!(polygon_polygon(&square(ci, 0.5), ci, &square(cj, 0.5), cj).is_none());
+        assert!(world_pp(&square(ci, 0.5), ci, &square(cj, 0.5), cj).is_none());
     }
 
     #[test]
@@ -435,21 +461,50 @@ mod tests {
             b: [5.0, 0.0],
         };
         let ci = [0.3, 0.45];
-        let g = polygon_wall(&square(ci, 0.5), ci, &w).unwrap();
+        let (g, point) = world_pw(&square(ci, 0.5), ci, &w).unwrap();
         assert!((g.area - 0.05).abs() < 1e-15);
         assert_eq!(g.n, [0.0, 1.0]);
-        assert!((g.point[0] - 0.3).abs() < 1e-15 && g.point[1] == 0.0);
+        assert!((point[0] - 0.3).abs() < 1e-15 && point[1] == 0.0);
         assert!((g.chord - 1.0).abs() < 1e-15 && (g.l - 0.45).abs() < 1e-15);
         // Beyond the wall's end only the part above the segment counts.
         let ci = [5.3, 0.45];
-        let g = polygon_wall(&square(ci, 0.5), ci, &w).unwrap();
+        let (g, point) = world_pw(&square(ci, 0.5), ci, &w).unwrap();
         assert!((g.area - 0.01).abs() < 1e-15);
-        assert!((g.chord - 0.2).abs() < 1e-15 && (g.point[0] - 4.9).abs() < 1e-15);
+        assert!((g.chord - 0.2).abs() < 1e-15 && (point[0] - 4.9).abs() < 1e-15);
     }
 }
 
-// ---- Disks under the overlap-area law (SPEC 2.3 for mixed scenes; the kernel twins are
-// in polygon.wgsl, built from exact depths) ----
+// ---- Disks under the overlap-area law (SPEC 2.3 for mixed scenes) ----
+//
+// The twins of polygon.wgsl's forms, step for step. A small overlap is built from an
+// overlap depth that does not cancel: a circular segment of known sagitta, a lens of
+// two segments, the triangle a corner cuts off plus a segment. General formulas (a
+// sum of signed triangles and sectors about the disk's centre, each of size r²) would
+// lose r² ε of area, 1e-4 of a corner 1e-6 d deep. Only a polygon–disk overlap that is
+// none of these (a deep one) takes the general formula.
+
+/// x − sin x, by its series where it cancels (relative error ~1e-16).
+pub fn x_minus_sin(x: f64) -> f64 {
+    if x > 1.0 {
+        return x - x.sin();
+    }
+    // x³/3! − x⁵/5! + …: the terms up to x¹⁹/19! reach f64's precision at x = 1.
+    let x2 = x * x;
+    let mut term = x * x2 / 6.0;
+    let mut sum = term;
+    for k in 2..=9 {
+        term *= -x2 / ((2 * k) as f64 * (2 * k + 1) as f64);
+        sum += term;
+    }
+    sum
+}
+
+/// Area of the circular segment of radius r beyond a chord at depth e (the sagitta):
+/// r²/2 (x − sin x) with x = 4 asin(sqrt(e / 2r)) the central angle.
+pub fn segment_area(r: f64, e: f64) -> f64 {
+    let y = (e / (2.0 * r)).clamp(0.0, 1.0).sqrt();
+    0.5 * r * r * x_minus_sin(4.0 * y.asin())
+}
 
 /// Signed area of the triangle (0, a, b) inside the circle of radius r about the origin:
 /// the segment ab is split where it crosses the circle; pieces inside add their triangle,
@@ -457,19 +512,22 @@ mod tests {
 fn triangle_in_circle(a: P2, b: P2, r: f64) -> f64 {
     let d = sub(b, a);
     let (qa, qb, qc) = (dot(d, d), 2.0 * dot(a, d), dot(a, a) - r * r);
-    let mut ts = vec![0.0];
+    let mut ts = [0.0, 1.0, 1.0, 1.0];
+    let mut n = 1;
     let disc = qb * qb - 4.0 * qa * qc;
     if qa > 0.0 && disc > 0.0 {
         let s = disc.sqrt();
         for t in [(-qb - s) / (2.0 * qa), (-qb + s) / (2.0 * qa)] {
             if t > 0.0 && t < 1.0 {
-                ts.push(t);
+                ts[n] = t;
+                n += 1;
             }
         }
     }
-    ts.push(1.0);
+    ts[n] = 1.0;
     let at = |t: f64| [a[0] + t * d[0], a[1] + t * d[1]];
-    ts.windows(2)
+    ts[..=n]
+        .windows(2)
         .map(|w| {
             let (p, q) = (at(w[0]), at(w[1]));
             let m = at(0.5 * (w[0] + w[1]));
@@ -483,12 +541,13 @@ fn triangle_in_circle(a: P2, b: P2, r: f64) -> f64 {
         .sum()
 }
 
-/// Points where the circle (c, r) crosses the outline of polygon p (half-open edges).
-fn circle_crossings(p: &[P2], c: P2, r: f64, out: &mut Poly) {
+/// Points where the circle of radius r about the origin crosses the outline of
+/// polygon p (half-open edges).
+fn circle_crossings(p: &[P2], r: f64, out: &mut Clip) {
     out.n = 0;
     let n = p.len();
     for k in 0..n {
-        let (a, b) = (sub(p[k], c), sub(p[(k + 1) % n], c));
+        let (a, b) = (p[k], p[(k + 1) % n]);
         let d = sub(b, a);
         let (qa, qb, qc) = (dot(d, d), 2.0 * dot(a, d), dot(a, a) - r * r);
         let disc = qb * qb - 4.0 * qa * qc;
@@ -498,141 +557,233 @@ fn circle_crossings(p: &[P2], c: P2, r: f64, out: &mut Poly) {
         let s = disc.sqrt();
         for t in [(-qb - s) / (2.0 * qa), (-qb + s) / (2.0 * qa)] {
             if (0.0..1.0).contains(&t) && out.n < MAX_CLIP {
-                out.push([c[0] + a[0] + t * d[0], c[1] + a[1] + t * d[1]]);
+                out.push([a[0] + t * d[0], a[1] + t * d[1]], k as u32);
             }
         }
     }
 }
 
-/// Area contact of polygon p (centre cp) and the disk (c, r); `polygon_is_i` says which
-/// of the two is particle i (n points from j to i). The force point is the midpoint of
-/// the two crossings farthest apart; corners of the polygon inside the disk and the
-/// disk's centre lie on the disk's side of that line.
-pub fn polygon_disk(p: &[P2], cp: P2, c: P2, r: f64, polygon_is_i: bool) -> Option<AreaContact> {
-    let n = p.len();
-    // No corner inside the circle, no edge cut by it and the centre outside the polygon:
-    // no overlap (the sum below would give round-off instead of zero). As in the kernel.
-    let inside = |v: P2| dot(sub(v, c), sub(v, c)) < r * r;
-    let (mut cut, mut centre_inside) = (false, true);
-    for k in 0..n {
-        let (a, ab) = (p[k], sub(p[(k + 1) % n], p[k]));
-        if cross(ab, sub(c, a)) < 0.0 {
-            centre_inside = false;
-        }
-        let t = dot(sub(c, a), ab) / dot(ab, ab);
-        let f = [a[0] + t * ab[0], a[1] + t * ab[1]];
-        cut |= t > 0.0 && t < 1.0 && inside(f);
-    }
-    if !cut && !centre_inside && !p.iter().any(|&v| inside(v)) {
+/// An overlap's area, chord, force point and the unit vector from the polygon's side
+/// to the disk's, in the disk's frame.
+type DiskOverlap = (f64, f64, P2, P2);
+
+/// A sliver under one face a–b (corners relative to the polygon's centre c; nothing
+/// else of the polygon in the circle): the segment beyond the face's line, whose depth
+/// is the radius less the centre's distance from the line. None: no overlap.
+fn face_segment(a: &P2, b: &P2, c: P2, r: f64) -> Option<DiskOverlap> {
+    let t = unit_or_up(sub(*b, *a));
+    let nout = [t[1], -t[0]]; // out of the polygon, towards the disk
+    // The face's distance from the disk's centre, from the polygon's own corner (not
+    // from c + a, which would round at the size of c).
+    let delta = r + dot(c, nout) + dot(*a, nout);
+    if delta <= 0.0 {
         return None;
     }
-    let area: f64 = (0..n)
-        .map(|k| triangle_in_circle(sub(p[k], c), sub(p[(k + 1) % n], c), r))
+    let chord = 2.0 * (delta * (2.0 * r - delta)).max(0.0).sqrt();
+    let point = [-(r - delta) * nout[0], -(r - delta) * nout[1]];
+    Some((segment_area(r, delta), chord, point, nout))
+}
+
+/// One corner `corner` inside the circle, `depth` deep, and no other edge cut: the
+/// triangle it cuts off with the circle plus the minor segment beyond the chord. None
+/// when the disk's centre lies beyond the chord (the rest of the disk is then a major
+/// segment, a deep overlap left to the general formula).
+fn corner_cap(v: &[P2], p: &[P2], corner: usize, depth: f64, r: f64) -> Option<DiskOverlap> {
+    let np = p.len();
+    let x = v[corner];
+    let u1 = unit_or_up(sub(p[(corner + np - 1) % np], p[corner]));
+    let u2 = unit_or_up(sub(p[(corner + 1) % np], p[corner]));
+    let k = depth * (2.0 * r - depth); // r² − |v|²
+    // How far along u the edge leaves the circle: s² + 2 b s − k = 0, without cancelling.
+    let reach = |b: f64| {
+        let root = (b * b + k).sqrt();
+        if b > 0.0 { k / (b + root) } else { root - b }
+    };
+    let (s1, s2) = (reach(dot(x, u1)), reach(dot(x, u2)));
+    // The chord from the corner's own frame: x2 − x1 = s2 u2 − s1 u1.
+    let x21 = [s2 * u2[0] - s1 * u1[0], s2 * u2[1] - s1 * u1[1]];
+    let chord = norm(x21);
+    let point = [
+        x[0] + 0.5 * (s1 * u1[0] + s2 * u2[0]),
+        x[1] + 0.5 * (s1 * u1[1] + s2 * u2[1]),
+    ];
+    let t = [x21[0] / chord.max(1e-300), x21[1] / chord.max(1e-300)];
+    let nn = [-t[1], t[0]];
+    let (centre_side, corner_side) = (-dot(nn, point), dot(nn, sub(x, point)));
+    if centre_side * corner_side < 0.0 {
+        return None;
+    }
+    let half = 0.5 * chord;
+    let sagitta = half * half / (r + (r * r - half * half).max(0.0).sqrt());
+    let area = 0.5 * s1 * s2 * cross(u1, u2).abs() + segment_area(r, sagitta);
+    let towards = if centre_side + corner_side > 0.0 {
+        nn
+    } else {
+        [-nn[0], -nn[1]]
+    };
+    Some((area, chord, point, towards))
+}
+
+/// Deep or unusual overlaps: the general formula (triangles and sectors about the
+/// disk's centre), the force point between the two crossings of the outlines farthest
+/// apart. `mask`: the corners inside the circle. None: no overlap.
+fn deep_overlap(v: &[P2], c: P2, r: f64, mask: u32) -> Option<DiskOverlap> {
+    let np = v.len();
+    let area: f64 = (0..np)
+        .map(|k| triangle_in_circle(v[k], v[(k + 1) % np], r))
         .sum();
     if area <= 0.0 {
         return None;
     }
-    let mut crossed = Poly::default();
-    circle_crossings(p, c, r, &mut crossed);
+    let mut crossed = Clip::default();
+    circle_crossings(v, r, &mut crossed);
     let xs = crossed.corners();
-    let scale = norm(sub(cp, c)) + r + norm(sub(p[0], cp));
-    let (ci, cj) = if polygon_is_i { (cp, c) } else { (c, cp) };
-    let centres = sub(ci, cj);
-    let along = if norm(centres) > 0.0 {
-        [centres[0] / norm(centres), centres[1] / norm(centres)]
-    } else {
-        [0.0, 1.0]
-    };
-    let (mut n_vec, point, chord) = if xs.len() >= 2 {
+    let (mut towards, mut point, mut chord) = (unit_or_up([-c[0], -c[1]]), [0.0, 0.0], 0.0);
+    if xs.len() >= 2 {
         let (a, b) = farthest_pair(xs);
-        let chord = norm(sub(b, a));
-        if chord > 1e-12 * scale {
-            let t = [(b[0] - a[0]) / chord, (b[1] - a[1]) / chord];
-            (
-                [-t[1], t[0]],
-                [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])],
-                chord,
-            )
-        } else {
-            (along, c, 0.0)
-        }
-    } else {
-        (along, c, 0.0)
-    };
-    if chord > 0.0 {
-        // Score the disk's side: its centre and the polygon's corners inside it.
-        let disk_side: f64 = dot(n_vec, sub(c, point))
-            + p.iter()
-                .filter(|v| dot(sub(**v, c), sub(**v, c)) < r * r)
-                .map(|v| dot(n_vec, sub(*v, point)))
-                .sum::<f64>();
-        // n must point from j to i: away from the disk when the polygon is i.
-        let towards_disk = disk_side > 0.0;
-        if towards_disk == polygon_is_i {
-            n_vec = [-n_vec[0], -n_vec[1]];
+        let d = norm(sub(b, a));
+        if d > 1e-12 * r {
+            let t = [(b[0] - a[0]) / d, (b[1] - a[1]) / d];
+            point = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+            chord = d;
+            towards = [-t[1], t[0]];
+            // The disk's side: its centre and the polygon's corners inside it.
+            let side = dot(towards, [-point[0], -point[1]])
+                + (0..np)
+                    .filter(|m| mask & (1 << m) != 0)
+                    .map(|m| dot(towards, sub(v[m], point)))
+                    .sum::<f64>();
+            if side < 0.0 {
+                towards = [-towards[0], -towards[1]];
+            }
         }
     }
-    let l = reduced_arm(norm(sub(point, ci)), norm(sub(point, cj)), scale);
+    Some((area, chord, point, towards))
+}
+
+/// Area contact of polygon p and a disk of radius r, in a frame at the disk's centre:
+/// `c` is the polygon's centre relative to the disk's (so p's corners in this frame are
+/// c + p). `polygon_is_i` says which of the two is particle i (n points from j to i);
+/// the result is in the frame of i's centre, as everywhere. The kernel twin is
+/// `polygon_disk_ij` in polygon.wgsl, with the same three cases.
+pub fn polygon_disk(p: &[P2], c: P2, r: f64, polygon_is_i: bool) -> Option<AreaContact> {
+    let np = p.len();
+    let mut v = [[0.0; 2]; MAX_CORNERS as usize];
+    for (x, y) in v.iter_mut().zip(p) {
+        *x = [c[0] + y[0], c[1] + y[1]];
+    }
+    let v = &v[..np];
+    // Corners inside the circle, by their depth r − |v|.
+    let (mut inside, mut mask, mut corner, mut depth) = (0, 0u32, 0, 0.0);
+    for (m, x) in v.iter().enumerate() {
+        let dm = r - norm(*x);
+        if dm > 0.0 {
+            inside += 1;
+            mask |= 1 << m;
+            corner = m;
+            depth = dm;
+        }
+    }
+    // Edges with both ends outside that the circle cuts (`cut` of them with the disk's
+    // centre on their outer side), and whether the centre is inside the polygon. With
+    // no corner inside, no edge cut and the centre outside there is no overlap.
+    let (mut cut, mut cut_any, mut edge, mut centre_inside) = (0, 0, 0, true);
+    for m in 0..np {
+        let m2 = (m + 1) % np;
+        let (a, ab) = (v[m], sub(v[m2], v[m]));
+        let outside = cross(ab, [-a[0], -a[1]]) < 0.0;
+        if outside {
+            centre_inside = false;
+        }
+        let t = -dot(a, ab) / dot(ab, ab);
+        let f = [a[0] + t * ab[0], a[1] + t * ab[1]];
+        let ends_out = mask & ((1 << m) | (1 << m2)) == 0;
+        if ends_out && t > 0.0 && t < 1.0 && dot(f, f) < r * r {
+            cut_any += 1;
+            if outside {
+                cut += 1;
+                edge = m;
+            }
+        }
+    }
+    if inside == 0 && cut == 0 && !centre_inside {
+        return None;
+    }
+    let (area, chord, point, towards_disk) = if inside == 0 && cut == 1 && cut_any == 1 {
+        face_segment(&p[edge], &p[(edge + 1) % np], c, r)?
+    } else if let Some(cap) = (inside == 1 && cut_any == 0)
+        .then(|| corner_cap(v, p, corner, depth, r))
+        .flatten()
+    {
+        cap
+    } else {
+        deep_overlap(v, c, r, mask)?
+    };
+    if area <= 0.0 {
+        return None;
+    }
+    let n = if polygon_is_i {
+        [-towards_disk[0], -towards_disk[1]]
+    } else {
+        towards_disk
+    };
+    let scale = norm(c) + 2.0 * r;
+    let l = reduced_arm(norm(sub(point, c)), norm(point), scale);
+    // From the disk's frame to i's.
+    let arm = if polygon_is_i { sub(point, c) } else { point };
     Some(AreaContact {
         area,
-        n: n_vec,
-        point,
+        n,
+        arm,
         chord,
         l,
     })
 }
 
-/// Area contact of two disks: the lens between them, the chord through the circles'
-/// crossings, n along the line of centres.
-pub fn disk_disk_area(ci: P2, ri: f64, cj: P2, rj: f64) -> Option<AreaContact> {
-    let dv = sub(ci, cj);
-    let d = norm(dv);
-    if d >= ri + rj {
+/// Area contact of two disks whose centres are d = r_i − r_j apart: the lens between
+/// them, of two segments whose sagittas come from the overlap δ = r_i + r_j − |d|; the
+/// chord through the circles' crossings, n along the line of centres.
+pub fn disk_disk_area(d: P2, ri: f64, rj: f64) -> Option<AreaContact> {
+    let dist = norm(d);
+    if dist >= ri + rj {
         return None;
     }
-    let n = if d > 0.0 {
-        [dv[0] / d, dv[1] / d]
-    } else {
-        [0.0, 1.0]
-    };
-    if d <= (ri - rj).abs() {
+    let n = unit_or_up(d);
+    if dist <= (ri - rj).abs() {
         // One inside the other: the smaller disk's area, at its centre.
-        let (small, cs) = if ri < rj { (ri, ci) } else { (rj, cj) };
-        let area = std::f64::consts::PI * small * small;
-        let l = reduced_arm(norm(sub(cs, ci)), norm(sub(cs, cj)), ri + rj);
+        let area = std::f64::consts::PI * ri.min(rj).powi(2);
+        let arm = if ri < rj { [0.0, 0.0] } else { [-d[0], -d[1]] };
+        let l = reduced_arm(norm(arm), norm([arm[0] + d[0], arm[1] + d[1]]), ri + rj);
         return Some(AreaContact {
             area,
             n,
-            point: cs,
+            arm,
             chord: 0.0,
             l,
         });
     }
-    // Distances of the chord from each centre along the line of centres.
-    let a_j = (d * d + rj * rj - ri * ri) / (2.0 * d);
-    let a_i = d - a_j;
-    let h = (rj * rj - a_j * a_j).max(0.0).sqrt();
-    // Circular segment beyond a chord at distance a from the centre of a circle r.
-    let segment = |r: f64, a: f64| {
-        let theta = h.atan2(a);
-        r * r * (theta - theta.sin() * theta.cos())
-    };
-    let area = segment(ri, a_i) + segment(rj, a_j);
-    let point = [cj[0] + n[0] * a_j, cj[1] + n[1] * a_j];
-    let l = reduced_arm(a_i.abs(), a_j.abs(), ri + rj);
+    // The chord lies a_i = r_i − e_i from i's centre and a_j = r_j − e_j from j's.
+    let delta = ri + rj - dist;
+    let ei = delta * (rj + dist - ri) / (2.0 * dist);
+    let ej = delta * (ri + dist - rj) / (2.0 * dist);
+    let area = segment_area(ri, ei) + segment_area(rj, ej);
+    let chord = 2.0 * (ej * (2.0 * rj - ej)).max(0.0).sqrt();
+    let arm = [-n[0] * (ri - ei), -n[1] * (ri - ei)];
+    let l = reduced_arm(ri - ei, rj - ej, ri + rj);
     Some(AreaContact {
         area,
         n,
-        point,
-        chord: 2.0 * h,
+        arm,
+        chord,
         l,
     })
 }
 
-/// Area contact of a disk and a wall segment: the circular segment beyond the wall's
-/// line; where the chord reaches past an end of the wall only the part over the wall
-/// counts (its area scaled by that fraction of the chord, an approximation at the ends).
-pub fn disk_wall_area(c: P2, r: f64, w: &WallSegment) -> Option<AreaContact> {
+/// Area contact of a disk of radius r and a wall segment given relative to the disk's
+/// centre (`geometry::wall_from`): the circular segment beyond the wall's line; where
+/// the chord reaches past an end of the wall only the part over the wall counts (its
+/// area scaled by that fraction of the chord, an approximation at the ends).
+pub fn disk_wall_area(r: f64, w: &WallSegment) -> Option<AreaContact> {
     let ab = sub(w.b, w.a);
     let len = norm(ab);
     if len == 0.0 {
@@ -640,31 +791,56 @@ pub fn disk_wall_area(c: P2, r: f64, w: &WallSegment) -> Option<AreaContact> {
     }
     let t = [ab[0] / len, ab[1] / len];
     let mut m = [-t[1], t[0]];
-    let mut dist = dot(m, sub(c, w.a));
+    // The centre's distance from the wall's line, on its side.
+    let mut dist = -dot(m, w.a);
     if dist < 0.0 {
         m = [-m[0], -m[1]];
         dist = -dist;
     }
-    if dist >= r {
+    let delta = r - dist;
+    if delta <= 0.0 {
         return None;
     }
-    let h = (r * r - dist * dist).sqrt();
-    let s = dot(sub(c, w.a), t);
+    let h = (delta * (2.0 * r - delta)).sqrt();
+    let s = -dot(w.a, t);
     let (lo, hi) = ((s - h).max(0.0), (s + h).min(len));
     if hi <= lo {
         return None;
     }
-    let theta = h.atan2(dist);
-    let full = r * r * (theta - theta.sin() * theta.cos());
-    let area = full * (hi - lo) / (2.0 * h);
+    let area = segment_area(r, delta) * (hi - lo) / (2.0 * h);
     let mid = 0.5 * (lo + hi);
-    let point = [w.a[0] + mid * t[0], w.a[1] + mid * t[1]];
-    let l = norm(sub(point, c)).max(1e-9 * r);
+    let arm = [w.a[0] + mid * t[0], w.a[1] + mid * t[1]];
+    let l = norm(arm).max(1e-9 * r);
     Some(AreaContact {
         area,
         n: m,
-        point,
+        arm,
         chord: hi - lo,
         l,
     })
+}
+
+#[cfg(test)]
+mod disk_tests {
+    use super::*;
+
+    #[test]
+    fn x_minus_sin_and_segments_match_their_closed_forms() {
+        // Small x against the series' leading terms (the next is below 1e-17 relative),
+        // larger x against the direct difference.
+        for x in [1e-6f64, 1e-3, 0.01] {
+            let series = x * x * x / 6.0 * (1.0 - x * x / 20.0 + x.powi(4) / 840.0);
+            assert!((x_minus_sin(x) / series - 1.0).abs() < 1e-14, "{x}");
+        }
+        for x in [0.05, 0.1, 0.5, 0.999, 1.0, 1.5, 3.0] {
+            assert!((x_minus_sin(x) / (x - x.sin()) - 1.0).abs() < 1e-11, "{x}");
+        }
+        // A half disk: the chord through the centre.
+        let r = 0.7;
+        assert!((segment_area(r, r) - 0.5 * std::f64::consts::PI * r * r).abs() < 1e-15);
+        // A shallow segment: 4/3 sqrt(2r) e^{3/2} (1 − 3e/(20 r) + O(e²)).
+        let e = 1e-8f64;
+        let approx = 4.0 / 3.0 * (2.0 * r).sqrt() * e.powf(1.5) * (1.0 - 3.0 * e / (20.0 * r));
+        assert!((segment_area(r, e) / approx - 1.0).abs() < 1e-12);
+    }
 }

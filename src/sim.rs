@@ -11,7 +11,7 @@ use crate::integrate::{gear, leapfrog};
 use crate::law::ContactLaw;
 use crate::rng::Rng;
 use crate::scene::{Creation, IntegratorKind, Scene, SceneError};
-use crate::shape::{WorldShapes, world_shapes};
+use crate::shape::{RotatedCorners, rotate_corners};
 use crate::springs::{SpringTable, gather_history, store_history};
 use crate::state::{Dof, Particles};
 
@@ -71,8 +71,8 @@ pub struct Simulation {
     pub device_state: Option<crate::gpu::DeviceState>,
     // Per-step buffers, rebuilt every step (not part of the state).
     pub cells: CellList,
-    /// World corners of the polygons at the current step.
-    pub shapes: WorldShapes,
+    /// The polygons' corners turned to their orientations at the current step.
+    pub corners: RotatedCorners,
     pub pairs: Vec<Pair>,
     pub contacts: Vec<ContactForce>,
     history_in: Vec<f64>,
@@ -137,7 +137,7 @@ impl Simulation {
             lost,
             device_state: None,
             cells: CellList::default(),
-            shapes: WorldShapes::default(),
+            corners: RotatedCorners::default(),
             pairs: Vec::new(),
             contacts: Vec::new(),
             history_in: Vec::new(),
@@ -179,17 +179,18 @@ impl Simulation {
             && self.time() >= self.scene.gravity.ramp_time
     }
 
-    /// Stages 2–8 at the current (predicted) state: cell list, world shapes, contacts,
-    /// their springs from the previous step, and every contact's force.
-    fn evaluate_contacts(&mut self) {
+    /// Stages 2–8 at the current (predicted) state: cell list, rotated corners, contacts,
+    /// their springs from the previous step, and every contact's force. Public for
+    /// measurements and tests of the contacts of a given state; it does not advance.
+    pub fn evaluate_contacts(&mut self) {
         self.cells
             .build(&self.grid, &self.particles.q[0], &self.particles.active);
-        world_shapes(&self.particles, &mut self.shapes);
+        rotate_corners(&self.particles, &mut self.corners);
         find_contacts(
             &self.grid,
             &self.cells,
             &self.particles,
-            &self.shapes,
+            &self.corners,
             &self.walls,
             self.law.range_factor(),
             &mut self.pairs,
@@ -197,7 +198,7 @@ impl Simulation {
         gather_history(&self.springs, &self.pairs, &mut self.history_in);
         contact_forces(
             &self.particles,
-            &self.shapes,
+            &self.corners,
             &self.walls,
             &self.law,
             self.scene.dt,

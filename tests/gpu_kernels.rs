@@ -13,7 +13,7 @@ use talus::gpu::GpuSimulation;
 use talus::gpu::kernels::Kernel;
 use talus::gpu::layout::{Entry, MAX_CONTACTS};
 use talus::rng::Rng;
-use talus::shape::{WorldShapes, world_shapes};
+use talus::shape::{RotatedCorners, rotate_corners};
 
 /// `n` disks of diameter 0.8–1.2 on a jittered lattice in a box with walls, some
 /// overlapping, with random velocities and spins; every 7th one fixed.
@@ -194,8 +194,8 @@ fn find_contacts_matches_the_cpu_for_both_laws() {
         let grid = gpu_grid(&g);
         let mut cells = CellList::default();
         cells.build(&grid, &host.particles.q[0], &host.particles.active);
-        let mut shapes = WorldShapes::default();
-        world_shapes(&host.particles, &mut shapes);
+        let mut shapes = RotatedCorners::default();
+        rotate_corners(&host.particles, &mut shapes);
         let mut cpu = Vec::new();
         find_contacts(
             &grid,
@@ -228,8 +228,8 @@ fn cpu_contact_forces(
     history: &[f64],
 ) -> (Vec<talus::forces::ContactForce>, Vec<f64>) {
     let (mut cpu, mut hist_out) = (Vec::new(), Vec::new());
-    let mut shapes = WorldShapes::default();
-    world_shapes(&host.particles, &mut shapes);
+    let mut shapes = RotatedCorners::default();
+    rotate_corners(&host.particles, &mut shapes);
     contact_forces(
         &host.particles,
         &shapes,
@@ -663,7 +663,12 @@ fn touching_pairs(pairs: usize, seed: u64) -> talus::sim::Simulation {
         let ci = p.q[0][i];
         let touch = |s: f64, b: &mut Vec<[f64; 2]>| {
             world(&p.shape[j], [s * u[0], s * u[1]], tj, b);
-            polygon_polygon(&a, [0.0, 0.0], b, [s * u[0], s * u[1]]).is_some()
+            polygon_polygon(
+                &a,
+                &common::relative(b, [s * u[0], s * u[1]]),
+                [-s * u[0], -s * u[1]],
+            )
+            .is_some()
         };
         let (mut lo, mut hi) = (0.0, 2.0);
         for _ in 0..80 {
@@ -813,7 +818,7 @@ fn touching_mixed(pairs: usize, seed: u64) -> talus::sim::Simulation {
             2 => s < p.radius[i] + rj,
             _ => {
                 world(&p.shape[i], [0.0, 0.0], ti, a);
-                polygon_disk(a, [0.0, 0.0], [s * u[0], s * u[1]], rj, true).is_some()
+                polygon_disk(a, [-s * u[0], -s * u[1]], rj, true).is_some()
             }
         };
         let (mut lo, mut hi) = (0.0, 3.0);
@@ -947,8 +952,8 @@ fn degenerate_polygon_contacts_vary_continuously_on_the_gpu() {
     let count = g.read_u32("contact_count", host.particles.len());
     let out = g.read_contact_out(host.particles.len() * MAX_CONTACTS as usize);
     let k_n = 2000.0;
-    let mut shapes = WorldShapes::default();
-    world_shapes(&host.particles, &mut shapes);
+    let mut shapes = RotatedCorners::default();
+    rotate_corners(&host.particles, &mut shapes);
     assert!(
         pairs.iter().all(|p| p.j == p.i + 1 && p.i % 2 == 0),
         "only partners touch"
@@ -968,13 +973,11 @@ fn degenerate_polygon_contacts_vary_continuously_on_the_gpu() {
                 "{name}: step {k} not finite"
             );
             gpu_f.push(f);
-            let (pi, pj) = (host.particles.position(i), host.particles.position(i + 1));
-            cpu_f.push(
-                match polygon_polygon(shapes.of(i), pi, shapes.of(i + 1), pj) {
-                    Some(c) => [c.area / c.l * c.n[0], c.area / c.l * c.n[1]],
-                    None => [0.0, 0.0],
-                },
-            );
+            let d = talus::forces::offset(&host.particles, i, i + 1);
+            cpu_f.push(match polygon_polygon(shapes.of(i), shapes.of(i + 1), d) {
+                Some(c) => [c.area / c.l * c.n[0], c.area / c.l * c.n[1]],
+                None => [0.0, 0.0],
+            });
         }
         let scale = cpu_f.iter().map(|f| f[0].hypot(f[1])).fold(0.0, f64::max);
         let jump = gpu_f

@@ -81,8 +81,9 @@ fn leapfrog_converges_at_second_order() {
 /// Undamped, frictionless disks bouncing in a walled box under gravity: kinetic +
 /// elastic + potential energy stays constant. Gear is not symplectic and each contact
 /// onset (a kink in the force) costs a little: measured drift 2.1e-4 at dt = t_c/60 and
-/// 2.1e-5 at t_c/120 over 20 time units (thousands of contact-steps). Bound: 5e-5 at
-/// dt = t_c/120.
+/// 2–5e-5 at t_c/120 over 20 time units (thousands of contact-steps). The collisions are
+/// chaotic, so the drift is a property of the trajectory: moving one disk by 1e-13 gave
+/// 2.9e-5 to 5.3e-5 (measured). Bound: 1e-4 at dt = t_c/120, twice the largest seen.
 #[test]
 fn energy_is_conserved_without_damping() {
     let particles: Vec<serde_json::Value> = (0..30)
@@ -123,7 +124,7 @@ fn energy_is_conserved_without_damping() {
         "the particles must collide ({contacts_seen} contact-steps)"
     );
     eprintln!("relative energy drift {worst}");
-    assert!(worst < 5e-5, "relative energy drift {worst}");
+    assert!(worst < 1e-4, "relative energy drift {worst}");
 }
 
 /// A straight column of disks on a floor, created at its exact equilibrium (contact k

@@ -4,7 +4,7 @@ use talus::cell_list::{CellList, Grid};
 use talus::contacts::{brute_force_contacts, find_contacts};
 use talus::geometry::WallSegment;
 use talus::rng::Rng;
-use talus::shape::{WorldShapes, circumradius, ellipse_polygon, world_shapes};
+use talus::shape::{RotatedCorners, circumradius, ellipse_polygon, rotate_corners};
 use talus::state::{NewParticle, Particles};
 
 /// A random polydisperse packing: `n` disks (or polygons of 3 to 8 corners on ellipses)
@@ -58,8 +58,8 @@ fn cell_list_contacts_equal_brute_force() {
     for seed in 0..20 {
         let polygons = seed % 2 == 1;
         let p = packing(seed, 300 + 37 * seed as usize, polygons);
-        let mut shapes = WorldShapes::default();
-        world_shapes(&p, &mut shapes);
+        let mut shapes = RotatedCorners::default();
+        rotate_corners(&p, &mut shapes);
         let ranges: &[f64] = if polygons { &[1.0] } else { &[1.0, 1.2] };
         for &range in ranges {
             // Cells at the minimum size and larger ones: the result must not depend on it.

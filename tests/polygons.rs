@@ -5,7 +5,6 @@
 mod common;
 use common::*;
 use serde_json::json;
-use talus::overlap::polygon_polygon;
 use talus::rng::Rng;
 use talus::shape::{P2, area, ellipse_polygon, world};
 
@@ -99,7 +98,7 @@ fn overlap_geometry_of_random_convex_pairs() {
         let cj = [rng.range(-1.2, 1.2), rng.range(-1.2, 1.2)];
         let (q, cj) = random_polygon(&mut rng, cj);
         let expect = hull_area(&p, &q);
-        let Some(g) = polygon_polygon(&p, ci, &q, cj) else {
+        let Some((g, point)) = polygon_polygon_world(&p, ci, &q, cj) else {
             assert!(expect < 1e-12, "missed an overlap of area {expect}");
             continue;
         };
@@ -117,10 +116,7 @@ fn overlap_geometry_of_random_convex_pairs() {
             // S is the midpoint of two points on both outlines, half a chord apart along t.
             let t = [-g.n[1], g.n[0]];
             for s in [-0.5, 0.5] {
-                let x = [
-                    g.point[0] + s * g.chord * t[0],
-                    g.point[1] + s * g.chord * t[1],
-                ];
+                let x = [point[0] + s * g.chord * t[0], point[1] + s * g.chord * t[1]];
                 assert!(
                     distance_to_outline(x, &p) < 1e-9,
                     "crossing point on i's outline"
@@ -146,13 +142,11 @@ fn overlap_geometry_of_random_convex_pairs() {
             }
         }
         // Swapping i and j: same area, point and arm; opposite normal.
-        let h = polygon_polygon(&q, cj, &p, ci).unwrap();
+        let (h, h_point) = polygon_polygon_world(&q, cj, &p, ci).unwrap();
         assert!((h.area - g.area).abs() < 1e-12);
         assert!((h.l - g.l).abs() < 1e-12);
         if g.chord > 1e-6 {
-            assert!(
-                (h.point[0] - g.point[0]).abs() < 1e-12 && (h.point[1] - g.point[1]).abs() < 1e-12
-            );
+            assert!((h_point[0] - point[0]).abs() < 1e-12 && (h_point[1] - point[1]).abs() < 1e-12);
             assert!((h.n[0] + g.n[0]).abs() < 1e-9 && (h.n[1] + g.n[1]).abs() < 1e-9);
         }
     }
@@ -214,12 +208,14 @@ fn swapping_the_two_polygons_gives_equal_and_opposite_forces() {
             && (c1.force[1] + c2.force[1]).abs() < 1e-12 * f
     );
     assert!((c1.point[0] - c2.point[0]).abs() < 1e-14 && (c1.point[1] - c2.point[1]).abs() < 1e-14);
-    // Torques about each centre from the common force point: angular momentum about the
-    // origin is conserved, τ_A + τ_B + r_A × F + r_B × (−F) = 0.
+    // Torques about each centre (where the contact was evaluated: the force point less
+    // its arm) from the common force point: angular momentum about the origin is
+    // conserved, τ_A + τ_B + r_A × F + r_B × (−F) = 0.
     let cross = |l: [f64; 2], f: [f64; 2]| l[0] * f[1] - l[1] * f[0];
-    let tau_a = cross([c1.point[0] - a1[0], c1.point[1] - a1[1]], c1.force);
-    let tau_b = cross([c2.point[0] - b1[0], c2.point[1] - b1[1]], c2.force);
-    let total = tau_a + tau_b + cross(a1, c1.force) + cross(b1, c2.force);
+    let at = |c: &talus::forces::ContactForce| [c.point[0] - c.arm[0], c.point[1] - c.arm[1]];
+    let tau_a = cross(c1.arm, c1.force);
+    let tau_b = cross(c2.arm, c2.force);
+    let total = tau_a + tau_b + cross(at(&c1), c1.force) + cross(at(&c2), c2.force);
     assert!(total.abs() < 1e-12 * f, "angular momentum balance {total}");
 }
 
@@ -433,7 +429,7 @@ fn integrated_area(p: &[P2], c: P2, r: f64) -> f64 {
 
 #[test]
 fn polygon_disk_and_disk_disk_overlaps() {
-    use talus::overlap::{disk_disk_area, polygon_disk};
+    use talus::overlap::disk_disk_area;
     let mut rng = Rng::new(11);
     let mut checked = 0;
     for _ in 0..300 {
@@ -441,7 +437,7 @@ fn polygon_disk_and_disk_disk_overlaps() {
         let c = [rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)];
         let r = rng.range(0.3, 0.8);
         let expect = integrated_area(&p, c, r);
-        let Some(g) = polygon_disk(&p, cp, c, r, true) else {
+        let Some((g, point)) = polygon_disk_world(&p, cp, c, r, true) else {
             assert!(expect < 1e-9, "missed an overlap of area {expect}");
             continue;
         };
@@ -451,7 +447,7 @@ fn polygon_disk_and_disk_disk_overlaps() {
             "area {} vs {expect}",
             g.area
         );
-        let h = polygon_disk(&p, cp, c, r, false).unwrap();
+        let (h, _) = polygon_disk_world(&p, cp, c, r, false).unwrap();
         assert_eq!(h.area, g.area);
         assert!((h.l - g.l).abs() < 1e-12);
         if g.chord > 1e-6 && g.area < 0.1 * area(&p).min(std::f64::consts::PI * r * r) {
@@ -463,10 +459,7 @@ fn polygon_disk_and_disk_disk_overlaps() {
             // Crossings on both outlines, and n pointing from the disk to the polygon.
             let t = [-g.n[1], g.n[0]];
             for s in [-0.5, 0.5] {
-                let x = [
-                    g.point[0] + s * g.chord * t[0],
-                    g.point[1] + s * g.chord * t[1],
-                ];
+                let x = [point[0] + s * g.chord * t[0], point[1] + s * g.chord * t[1]];
                 assert!(distance_to_outline(x, &p) < 1e-9);
                 assert!(((x[0] - c[0]).hypot(x[1] - c[1]) - r).abs() < 1e-9);
             }
@@ -485,7 +478,7 @@ fn polygon_disk_and_disk_disk_overlaps() {
     // Two disks: the lens against the integral over a 16-gon-free circle pair, by the
     // same strip integration of the two circles' vertical chords.
     for (d, r1, r2) in [(1.9, 1.0, 1.0), (1.2, 1.0, 0.5), (0.9999, 0.5, 0.5)] {
-        let g = disk_disk_area([d, 0.0], r1, [0.0, 0.0], r2).unwrap();
+        let g = disk_disk_area([d, 0.0], r1, r2).unwrap();
         let n = 400_000;
         let (lo, hi) = ((d - r1).max(-r2), r2.min(d + r1));
         let h = (hi - lo) / n as f64;
@@ -557,8 +550,8 @@ fn a_disk_rests_on_a_square_and_the_floor_carries_both() {
 
 /// The elastic force direction and size (A/l along n) of polygon i against j.
 fn overlap_force(p: &[P2], ci: P2, q: &[P2], cj: P2) -> [f64; 2] {
-    match polygon_polygon(p, ci, q, cj) {
-        Some(g) => {
+    match polygon_polygon_world(p, ci, q, cj) {
+        Some((g, _)) => {
             assert!(
                 g.area.is_finite() && g.l.is_finite() && g.n[0].is_finite() && g.n[1].is_finite(),
                 "non-finite geometry"

@@ -116,6 +116,9 @@ pub struct ContactOut {
     pub ft: [f32; 4],
     /// f_n, f_t, overlap, elastic energy.
     pub info: [f32; 4],
+    /// The geometry the device used: the normal (n_x, n_z) from j to i and the contact
+    /// point relative to i's centre (written for outputs, not read by the kernels).
+    pub geo: [f32; 4],
 }
 
 #[repr(C)]
@@ -241,7 +244,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 shape
             ]
         ),
-        fields!(ContactOut, "ContactOut", [ft, info]),
+        fields!(ContactOut, "ContactOut", [ft, info, geo]),
         fields!(
             Wall,
             "Wall",

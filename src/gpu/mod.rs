@@ -870,32 +870,21 @@ impl GpuSimulation {
         let outs: Vec<ContactOut> = self.read_buffer(&self.buffers.contact_out, 0, live * m);
         let mut pairs = Vec::new();
         let mut contacts = Vec::new();
-        // The contact point and normal are not read back: they are recomputed on the
-        // host from the downloaded state, with the CPU path's geometry.
+        // Every contact as the device computed it: its force, normal and contact point
+        // (relative to i's centre), converted exactly from f32 (issue 19).
         let parts = &self.sim.particles;
-        let mut shapes = crate::shape::WorldShapes::default();
-        crate::shape::world_shapes(parts, &mut shapes);
-        let area = matches!(self.sim.law, ContactLaw::OverlapArea(_));
-        let dt = self.sim.scene.dt;
         for i in 0..live {
             for k in 0..count[i] as usize {
                 let j = js[i * m + k];
                 let o = outs[i * m + k];
-                let pair = Pair { i: i as u32, j };
-                let (g, _) = crate::forces::contact_input(
-                    parts,
-                    &shapes,
-                    &self.sim.walls,
-                    dt,
-                    area,
-                    pair,
-                    0.0,
-                );
-                pairs.push(pair);
+                let p = parts.position(i);
+                let arm = [o.geo[2] as f64, o.geo[3] as f64];
+                pairs.push(Pair { i: i as u32, j });
                 contacts.push(ContactForce {
                     force: [o.ft[0] as f64, o.ft[1] as f64],
-                    point: g.point,
-                    n: g.n,
+                    point: [p[0] + arm[0], p[1] + arm[1]],
+                    arm,
+                    n: [o.geo[0] as f64, o.geo[1] as f64],
                     f_n: o.info[0] as f64,
                     f_t: o.info[1] as f64,
                     overlap: o.info[2] as f64,

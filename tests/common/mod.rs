@@ -5,6 +5,8 @@ use serde_json::{Value, json};
 use talus::scene::{self, Scene};
 use talus::sim::Simulation;
 
+pub mod pairs;
+
 /// A scene around `particles` and `contact`, with a large domain, no gravity by default.
 pub fn scene_value(contact: Value, particles: Value) -> Value {
     json!({
@@ -112,4 +114,42 @@ pub fn layered_pile(polygons: bool) -> serde_json::Value {
     v["gravity"] = json!({ "g": [0.0, -1.0] });
     v["walls"] = json!([{ "from": [-30.0, 0.0], "to": [30.0, 0.0] }]);
     v
+}
+
+/// Corners given in world coordinates, relative to the centre c (the contact geometry
+/// takes corners relative to their centre and the offset between centres).
+pub fn relative(v: &[[f64; 2]], c: [f64; 2]) -> Vec<[f64; 2]> {
+    v.iter().map(|x| [x[0] - c[0], x[1] - c[1]]).collect()
+}
+
+/// `polygon_polygon` of polygons given in world coordinates, with the force point back
+/// in world coordinates.
+pub fn polygon_polygon_world(
+    p: &[[f64; 2]],
+    ci: [f64; 2],
+    q: &[[f64; 2]],
+    cj: [f64; 2],
+) -> Option<(talus::overlap::AreaContact, [f64; 2])> {
+    let d = [ci[0] - cj[0], ci[1] - cj[1]];
+    talus::overlap::polygon_polygon(&relative(p, ci), &relative(q, cj), d)
+        .map(|g| (g, [ci[0] + g.arm[0], ci[1] + g.arm[1]]))
+}
+
+/// `polygon_disk` of a polygon (world corners, centre cp) and the disk (c, r), with the
+/// force point back in world coordinates.
+pub fn polygon_disk_world(
+    p: &[[f64; 2]],
+    cp: [f64; 2],
+    c: [f64; 2],
+    r: f64,
+    polygon_is_i: bool,
+) -> Option<(talus::overlap::AreaContact, [f64; 2])> {
+    let ci = if polygon_is_i { cp } else { c };
+    talus::overlap::polygon_disk(
+        &relative(p, cp),
+        [cp[0] - c[0], cp[1] - c[1]],
+        r,
+        polygon_is_i,
+    )
+    .map(|g| (g, [ci[0] + g.arm[0], ci[1] + g.arm[1]]))
 }
