@@ -123,7 +123,9 @@ struct Wall {
     b_frac: vec2<u32>,
     b_rem: vec2<f32>,
     ab: vec2<f32>,
-    _pad: vec2<f32>,
+    nq: vec2<i32>,      // the line's unit normal (-t.y, t.x) in Q30 (host: gpu/mod.rs)
+    beta: f32,          // nq/2^30 = (1 + alpha) n + beta t: its turn off the true normal
+    alpha: f32,         // and its stretch
 };
 
 struct Entry {

@@ -40,10 +40,72 @@ fn disk_disk(i: u32, j: u32) -> Geometry {
                       pi.radius_rem + pj.radius_rem, pi.radius);
 }
 
+// --- the line of a wall, exactly (issue 18) ---
+
+// Q30: unit vectors in integers, 2^30 to one.
+const Q30: f32 = 1073741824.0;
+
+// A 64-bit value times 2^30, modulo 2^64.
+fn shl30(v: vec2<u32>) -> vec2<u32> {
+    return vec2<u32>(v.x << 30u, (v.y << 30u) | (v.x >> 2u));
+}
+
+// The line of wall w seen from particle i's centre c. The wall carries its unit normal
+// n in Q30 integers, q (host: gpu/mod.rs `wall_normal`), and the turn beta of q off n.
+// (c - a).q is exact in 64-bit integers: (da 2^30 + df).q from the anchor and frac
+// differences, modulo 2^64, which is the true value within 8 cells of the line (the
+// large products cancel). With q = (1 + alpha) n + beta t, the true distance is
+// (c - a).n = ((c - a).q - beta (c - a).t) / (1 + alpha) (alpha, beta ~2^-31, to first
+// order), plus the remainders' part: exact for any line,
+// long and inclined; an axis-aligned one has q = (0, 2^30) or so, alpha = beta = 0.
+struct WallLine {
+    n: vec2<f32>,       // the unit normal, from the line towards c
+    t: vec2<f32>,       // along the wall, from a to b
+    q: vec2<i32>,       // n in Q30
+    c64: vec2<u32>,     // (c - a).q, units x 2^30, two's complement, >= 0
+    small: f32,         // the rest of c's distance from the line (units)
+    beta: f32,          // q's turn off n, oriented with q
+    alpha: f32,         // q's stretch: q = (1 + alpha) n + beta t
+    near: bool,         // c within 4 cells of the line (else c64 may have wrapped)
+};
+
+fn wall_line(i: u32, w: u32) -> WallLine {
+    let s = state[i];
+    let wall = walls[w];
+    let t = wall.ab / max(length(wall.ab), 1.0e-30);
+    var n = vec2<f32>(-t.y, t.x);
+    var q = wall.nq;
+    var beta = wall.beta;
+    let da = s.anchor - wall.a_anchor;
+    let df = vec2<i32>(s.frac) - vec2<i32>(wall.a_frac);
+    var c64 = add64(shl30(add64(smul(da.x, q.x), smul(da.y, q.y))),
+                    add64(smul(df.x, q.x), smul(df.y, q.y)));
+    let er = s.q[0].xy - wall.a_rem;
+    let p = offset_vector(offset(s.anchor, s.frac, s.q[0].xy, wall.a_anchor, wall.a_frac, wall.a_rem));
+    let along = dot(p, t) * params.inv_unit;
+    let near = abs(dot(p, n)) < 4.0 * params.cell_size;
+    if (i64_to_f32(c64) / Q30 + dot(er, n) - beta * along < 0.0) {
+        n = -n;
+        q = -q;
+        beta = -beta;
+        c64 = sub64(vec2<u32>(0u, 0u), c64);
+    }
+    // (c - a).n = ((c - a).q - beta along) / (1 + alpha), to first order in alpha.
+    let raw = i64_to_f32(c64) / Q30;
+    let small = dot(er, n) - beta * along - wall.alpha * raw;
+    return WallLine(n, t, q, c64, small, beta, wall.alpha, near);
+}
+
+// How deep a disk of radius r (whole units and remainder) reaches beyond the line: r
+// less the centre's distance, in units, with the large parts cancelling in integers.
+fn wall_depth(l: WallLine, r_units: u32, r_rem: f32) -> f32 {
+    let exact = sub64(vec2<u32>(r_units << 30u, r_units >> 2u), l.c64);
+    return i64_to_f32(exact) / Q30 + r_rem - l.small;
+}
+
 // A disk and a wall segment a-b, seen as a mirror disk (r = 2 dist, sigma = 2 radius).
-// End points are exact point pairs; the interior of an axis-aligned wall is exact along
-// its normal; the interior of an inclined wall falls back to f32 from its end point a
-// (6e-8 of the distance along the wall).
+// End points are exact point pairs; the interior is exact from the wall's line
+// (`wall_line`), axis-aligned or inclined.
 fn disk_wall(i: u32, w: u32) -> Geometry {
     let s = state[i];
     let pr = props[i];
@@ -63,26 +125,11 @@ fn disk_wall(i: u32, w: u32) -> Geometry {
         }
         g = point_pair(o, i32(pr.radius_units), pr.radius_rem, radius);
         if (!g.near) { return g; }
-    } else if (ab.x == 0.0 || ab.y == 0.0) {
-        // Normal along axis k; the coordinate along k is exact in units.
-        let k = select(0u, 1u, ab.y == 0.0);
-        if (abs(oa.da[k]) > 1) { return far_apart(); }
-        let along = f32(oa.d[k]) + oa.e[k];
-        let sgn = select(-1.0, 1.0, along >= 0.0);
-        let whole = i32(sgn) * oa.d[k];
-        let corr = sgn * oa.e[k];
-        var n = vec2<f32>(0.0);
-        n[k] = sgn;
-        let u = params.unit;
-        let delta = (f32(i32(pr.radius_units) - whole) + (pr.radius_rem - corr)) * u;
-        g = Geometry(n, delta, 0.0, 0.0, -n * (radius - 0.5 * delta), true);
     } else {
-        let d = p - t * ab;
-        let dist = length(d);
-        var n = vec2<f32>(-ab.y, ab.x) / sqrt(len2);
-        if (dist > 0.0) { n = d / dist; }
-        let delta = radius - dist;
-        g = Geometry(n, delta, 0.0, 0.0, -n * (radius - 0.5 * delta), true);
+        let l = wall_line(i, w);
+        if (!l.near) { return far_apart(); }
+        let delta = wall_depth(l, pr.radius_units, pr.radius_rem) * params.unit;
+        g = Geometry(l.n, delta, 0.0, 0.0, -l.n * (radius - 0.5 * delta), true);
     }
     // Mirror disk: the law sees two disks of this radius at twice the distance.
     g.sigma = 2.0 * radius;

@@ -34,7 +34,6 @@ const Q_LINE: u32 = 16u;
 const WALL_LINE: u32 = 32u;
 const END_A_LINE: u32 = 33u;
 const END_B_LINE: u32 = 34u;
-const Q30: f32 = 1073741824.0;
 
 struct AreaContact {
     area: f32,
@@ -382,18 +381,21 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
 }
 
 // Area contact of polygon p (centre at the origin, clip coordinates in units) with the
-// wall segment wa-wb: the part of p beyond the wall's line and between its end points.
-// For an axis-aligned wall whose line is exact in `oa` (the offset of its end a) the
-// area is recomputed exactly: w is then a corner's exact distance from the wall's line,
-// zero on it, and interpolated along p's edge where an edge crosses an end line; u is
-// measured from p's deepest corner, from exact integer offsets.
-fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, oa: Offset,
-                wall_ab: vec2<f32>, only_area: bool) -> AreaContact {
+// wall segment wa-wb whose line is `l` (geometry.wgsl `wall_line`): the part of p beyond
+// the wall's line and between its end points. The f32 clip finds which lines bound it;
+// the area is then recomputed exactly, as for two polygons: w is a corner's exact
+// distance from the wall's line (zero on it, interpolated along p's edge where an edge
+// crosses an end line), u is measured from p's deepest corner by exact integer offsets.
+fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: WallLine,
+                only_area: bool) -> AreaContact {
     let ab = wb - wa;
     let len = length(ab);
     if (len == 0.0) { return no_contact(); }
-    var m = vec2<f32>(-ab.y, ab.x) / len;
-    if (dot(m, -wa) < 0.0) { m = -m; }
+    let m = l.n;
+    // The wall's line through the foot of the centre, from its exact distance: an end
+    // point can be far (its f32 offset then carries f32's precision of that distance).
+    let dist = i64_to_f32(l.c64) / Q30 + l.small;
+    let foot = -dist * m;
     var c: Clip;
     let np = (*p).n;
     var r = 0.0;
@@ -404,7 +406,7 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, oa: Off
         r = max(r, length(c.v[0][k]));
         if (dot(c.v[0][k], m) < dot(c.v[0][deepest], m)) { deepest = k; }
     }
-    var n = clip_lines(&c, 0u, np, wa, -m, WALL_LINE);
+    var n = clip_lines(&c, 0u, np, foot, -m, WALL_LINE);
     n = clip_lines(&c, 1u, n, wa, ab, END_A_LINE);
     n = clip_lines(&c, 0u, n, wb, -ab, END_B_LINE);
     if (n < 3u) { return no_contact(); }
@@ -417,66 +419,40 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, oa: Off
     g.found = true;
     if (only_area && sh.x > margin) { return g; }
     let scale = len + r;
+    g.n = m;
+    g.point = corner_mean(&c, 1u, n);
+    g.l = max(length(g.point), 1.0e-6 * scale);
+    // The area from the lines: 1/2 sum (w_k + w_k+1)(u_k - u_k+1); the chord from the
+    // u of the corners on the wall's line.
+    let t = vec2<f32>(m.y, -m.x);
+    let base = (*p).w[deepest];
+    let first = wall_uw(p, &c, n, 0u, l, t, base);
+    var prev = first;
+    var a = 0.0;
     var lo = 3.0e38;
     var hi = -3.0e38;
-    for (var k = 0u; k < n; k++) {
-        // Corners on the wall's line (crossings, or a wall end inside p), by the lines
-        // they join.
-        let x = c.v[1][k];
-        if (c.line[1][(k + n - 1u) % n] == WALL_LINE || c.line[1][k] == WALL_LINE) {
-            let s = dot(x - wa, ab) / len;
-            lo = min(lo, s);
-            hi = max(hi, s);
-        }
+    for (var e = 1u; e <= n; e++) {
+        var x = first;
+        if (e < n) { x = wall_uw(p, &c, n, e, l, t, base); }
+        a += (prev.y + x.y) * (prev.x - x.x);
+        if (x.z > 0.0) { lo = min(lo, x.x); hi = max(hi, x.x); }
+        prev = x;
     }
-    g.n = m;
+    g.area = 0.5 * a;
     if (hi > lo) {
-        g.point = wa + (0.5 * (lo + hi) / len) * ab;
         g.chord = hi - lo;
-    } else {
-        g.point = corner_mean(&c, 1u, n);
-        g.chord = 0.0;
-    }
-    g.l = max(length(g.point), 1.0e-6 * scale);
-    // Exact for an axis-aligned wall: the normal along axis k, the wall's line exact in
-    // oa. The area as for two polygons, with w a corner's distance from the wall's line
-    // (zero on it); the chord from the crossings' u, interpolated with exact parameters.
-    // Whether the wall is axis-aligned is the host's exact b - a (`wall_ab`): wa and wb
-    // are f32 offsets that need not be exact when an end is more than a cell away; only
-    // the coordinate along the normal must be, a cell at most away.
-    let k = select(0u, 1u, wall_ab.y == 0.0);
-    if ((wall_ab.x == 0.0 || wall_ab.y == 0.0) && abs(oa.da[k]) <= 1) {
-        let sign = m[k];
-        let t = vec2<f32>(m.y, -m.x);
-        let base = (*p).w[deepest];
-        let first = wall_uw(p, &c, n, 0u, oa, k, sign, t, base);
-        var prev = first;
-        var a = 0.0;
-        var lo2 = 3.0e38;
-        var hi2 = -3.0e38;
-        for (var e = 1u; e <= n; e++) {
-            var x = first;
-            if (e < n) { x = wall_uw(p, &c, n, e, oa, k, sign, t, base); }
-            a += (prev.y + x.y) * (prev.x - x.x);
-            if (x.z > 0.0) { lo2 = min(lo2, x.x); hi2 = max(hi2, x.x); }
-            prev = x;
-        }
-        g.area = 0.5 * a;
-        if (hi2 > lo2) {
-            g.chord = hi2 - lo2;
-            g.point = (0.5 * (lo2 + hi2) + dot(vec2<f32>(base), t)) * t + dot(wa, m) * m;
-            g.l = max(length(g.point), 1.0e-6 * scale);
-        }
+        // On the wall's line: at the foot of the centre moved along t.
+        g.point = (0.5 * (lo + hi) + dot(vec2<f32>(base), t)) * t - dist * m;
+        g.l = max(length(g.point), 1.0e-6 * scale);
     }
     if (g.area <= 0.0) { return no_contact(); }
     return g;
 }
 
-// (u, w, on the wall's line) of corner e of the clipped polygon (buffer 1), for an
-// axis-aligned wall (normal `sign` along axis k, t along the wall); u from the integer
-// point `base` near the contact.
-fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, oa: Offset,
-           k: u32, sign: f32, t: vec2<f32>, base: vec2<i32>) -> vec3<f32> {
+// (u, w, on the wall's line) of corner e of the clipped polygon (buffer 1): u along t
+// from the integer point `base` near the contact, w the distance from the wall's line.
+fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, l: WallLine,
+           t: vec2<f32>, base: vec2<i32>) -> vec3<f32> {
     let lin = (*c).line[1][(e + n - 1u) % n];
     let lout = (*c).line[1][e];
     let np = (*p).n;
@@ -488,16 +464,14 @@ fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, oa
         if (edge < Q_LINE) {
             // An edge of p across the wall's line, at the exact parameter.
             let y = (edge + 1u) % np;
-            let wx = corner_wall_w(p, edge, oa, k, sign);
-            let wy = corner_wall_w(p, y, oa, k, sign);
-            let s = crossing_param(wx, wy);
+            let s = crossing_param(corner_wall_w(p, edge, l), corner_wall_w(p, y, l));
             let u = interpolate_w(corner_u(p, edge, base, t), corner_u(p, y, base, t), s).x;
             return vec3<f32>(u, 0.0, 1.0);
         }
         return vec3<f32>(u_at, 0.0, 1.0);   // an end point of the wall
     }
     if (lin < Q_LINE && lout < Q_LINE && lout == (lin + 1u) % np) {
-        return vec3<f32>(corner_u(p, lout, base, t), corner_wall_w(p, lout, oa, k, sign), 0.0);
+        return vec3<f32>(corner_u(p, lout, base, t), corner_wall_w(p, lout, l), 0.0);
     }
     if (edge < Q_LINE) {
         // An edge of p across an end line: along the edge, from its nearer end.
@@ -505,11 +479,12 @@ fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, oa
         let xf = corner_at(p, edge, vec2<i32>(0));
         let d = corner_at(p, y, vec2<i32>(0)) - xf;
         let s = clamp(dot(at - xf, d) / max(dot(d, d), 1.0e-30), 0.0, 1.0);
-        let w = interpolate_w(corner_wall_w(p, edge, oa, k, sign), corner_wall_w(p, y, oa, k, sign),
+        let w = interpolate_w(corner_wall_w(p, edge, l), corner_wall_w(p, y, l),
                               vec2<f32>(s, 1.0 - s)).x;
         return vec3<f32>(u_at, w, 0.0);
     }
-    return vec3<f32>(u_at, sign * (at[k] - (vec2<f32>(oa.d) + oa.e)[k]), 0.0);
+    // A wall end inside p, between two end or wall lines: f32.
+    return vec3<f32>(u_at, dot(at, l.n) + i64_to_f32(l.c64) / Q30 + l.small, 0.0);
 }
 
 // Corner m along t from the integer point `base` (exact offset, one rounding).
@@ -517,8 +492,14 @@ fn corner_u(p: ptr<function, Outline>, m: u32, base: vec2<i32>, t: vec2<f32>) ->
     return dot(vec2<f32>((*p).w[m] - base) + corner_e(p, m), t);
 }
 
-fn corner_wall_w(p: ptr<function, Outline>, m: u32, oa: Offset, k: u32, sign: f32) -> f32 {
-    return sign * (f32((*p).w[m][k] - oa.d[k]) + (corner_e(p, m)[k] - oa.e[k]));
+// Corner m's distance from the wall's line (units, positive on the centre's side): the
+// centre's exact (c - a).q plus the corner's w.q in 64-bit integers, and the small
+// parts (remainders, the turn beta of q).
+fn corner_wall_w(p: ptr<function, Outline>, m: u32, l: WallLine) -> f32 {
+    let w = (*p).w[m];
+    let exact = add64(l.c64, add64(smul(w.x, l.q.x), smul(w.y, l.q.y)));
+    return i64_to_f32(exact) / Q30 + l.small + dot(corner_e(p, m), l.n)
+        - l.beta * dot(vec2<f32>(w), l.t) - l.alpha * dot(vec2<f32>(w), l.n);
 }
 
 // The area contact of particle i with particle j (both polygons), in length units with
@@ -556,9 +537,11 @@ fn polygon_wall_iw(i: u32, w: u32, only_area: bool) -> AreaContact {
     let wall = walls[w];
     let oa = offset(wall.a_anchor, wall.a_frac, wall.a_rem, s.anchor, s.frac, s.q[0].xy);
     let ob = offset(wall.b_anchor, wall.b_frac, wall.b_rem, s.anchor, s.frac, s.q[0].xy);
+    let l = wall_line(i, w);
+    if (!l.near) { return no_contact(); }
     var p: Outline;
     load_outline(i, vec2<i32>(0), vec2<f32>(0.0), &p);
-    var g = polygon_wall(&p, offset_units(oa), offset_units(ob), oa, wall.ab, only_area);
+    var g = polygon_wall(&p, offset_units(oa), offset_units(ob), l, only_area);
     let u = params.unit;
     g.area *= u * u;
     g.chord *= u;
@@ -639,30 +622,26 @@ fn disk_wall_area(i: u32, w: u32) -> AreaContact {
     let len = length(wall.ab);
     if (len == 0.0) { return no_contact(); }
     let tt = wall.ab / len;
-    var m = vec2<f32>(-tt.y, tt.x);
-    var dist = dot(p, m);
-    if (dist < 0.0) { m = -m; dist = -dist; }
-    var delta = r - dist;
-    let k = select(0u, 1u, wall.ab.y == 0.0);
-    if ((wall.ab.x == 0.0 || wall.ab.y == 0.0) && abs(oa.da[k]) <= 1) {
-        // The coordinate along the normal is exact in units (as in `disk_wall`).
-        let sgn = select(-1.0, 1.0, f32(oa.d[k]) + oa.e[k] >= 0.0);
-        let whole = i32(sgn) * oa.d[k];
-        delta = (f32(i32(props[i].radius_units) - whole) + (props[i].radius_rem - sgn * oa.e[k])) * params.unit;
-        dist = r - delta;
-    }
+    // The depth beyond the wall's line, exact (geometry.wgsl `wall_line`).
+    let l = wall_line(i, w);
+    if (!l.near) { return no_contact(); }
+    let m = l.n;
+    let delta = wall_depth(l, props[i].radius_units, props[i].radius_rem) * params.unit;
+    let dist = r - delta;
     if (delta <= 0.0) { return no_contact(); }
     let h = sqrt(delta * (2.0 * r - delta));
+    // The chord's ends relative to the foot of the centre, cut at the wall's ends: not
+    // from `along` +- h, which far from a would round at f32's precision of `along`.
     let along = dot(p, tt);
-    let lo = max(along - h, 0.0);
-    let hi = min(along + h, len);
+    let lo = max(-h, -along);
+    let hi = min(h, len - along);
     if (hi <= lo) { return no_contact(); }
     var c = no_contact();
     c.found = true;
     c.area = segment_area(r, delta) * (hi - lo) / (2.0 * h);
     c.n = m;
     c.chord = hi - lo;
-    c.point = -dist * m + (0.5 * (lo + hi) - along) * tt;
+    c.point = -dist * m + (0.5 * (lo + hi)) * tt;
     c.l = max(length(c.point), 1.0e-9 * r);
     return c;
 }
@@ -705,6 +684,22 @@ fn depth_in_circle(w: vec2<i32>, e: vec2<f32>, r_units: u32, r_rem: f32) -> f32 
     return whole + (r_rem - dist.corr);
 }
 
+// Corner a minus corner b of an outline, from the exact integer offset (one rounding).
+fn corner_delta(p: ptr<function, Outline>, a: u32, b: u32) -> vec2<f32> {
+    return vec2<f32>((*p).w[a] - (*p).w[b]) + (corner_e(p, a) - corner_e(p, b));
+}
+
+// How far along the unit vector u from the point x, `depth` inside the circle of radius
+// r about the origin, the circle is reached: s^2 + 2 b s - k = 0 with b = x.u and
+// k = r^2 - |x|^2 = depth (2r - depth), without cancelling.
+fn circle_reach(x: vec2<f32>, u: vec2<f32>, depth: f32, r: f32) -> f32 {
+    let k = depth * (2.0 * r - depth);
+    let b = dot(x, u);
+    let root = sqrt(b * b + k);
+    if (b > 0.0) { return k / (b + root); }
+    return root - b;
+}
+
 // Area contact of polygon `poly` and disk `disk` (polygon_is_i: which one is i), in
 // length units with the force point relative to centre i. Frame: the disk's centre.
 fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
@@ -719,11 +714,9 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
     let np = p.n;
     var inside = 0u;
     var mask = 0u;
-    var corner = 0u;
-    var depth = 0.0;
     for (var m = 0u; m < np; m++) {
         let dm = depth_in_circle(p.w[m], corner_e(&p, m), ru, rr);
-        if (dm > 0.0) { inside++; mask |= 1u << m; corner = m; depth = dm; }
+        if (dm > 0.0) { inside++; mask |= 1u << m; }
     }
     // Edges with both ends outside that the circle cuts twice (`cut` of them with the
     // disk's centre on their outer side), and whether the centre is inside the polygon.
@@ -780,37 +773,55 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
         towards_disk = nout;
         done = true;
     }
-    if (!done && inside == 1u && cut_any == 0u) {
-        // One corner inside: the triangle it cuts off with the circle plus the minor
-        // segment beyond the chord, from its exact depth; unless the disk's centre lies
-        // beyond the chord (the rest is then a major segment: the general formula).
-        let v = corner_at(&p, corner, vec2<i32>(0));
-        let u1 = normalize(corner_at(&p, (corner + np - 1u) % np, vec2<i32>(0)) - v);
-        let u2 = normalize(corner_at(&p, (corner + 1u) % np, vec2<i32>(0)) - v);
-        let k = depth * (2.0 * r - depth);     // r^2 - |v|^2
-        let b1 = dot(v, u1);
-        let b2 = dot(v, u2);
-        var s1 = -b1 + sqrt(b1 * b1 + k);
-        if (b1 > 0.0) { s1 = k / (b1 + sqrt(b1 * b1 + k)); }
-        var s2 = -b2 + sqrt(b2 * b2 + k);
-        if (b2 > 0.0) { s2 = k / (b2 + sqrt(b2 * b2 + k)); }
-        // The chord from the corner's own frame: x2 - x1 = s2 u2 - s1 u1, not the
-        // difference of two points half a diameter out, which f32 rounds to ~3e-8 d.
-        let x21 = s2 * u2 - s1 * u1;
-        let chord = length(x21);
-        let half = 0.5 * chord;
-        let sag = half * half / (r + sqrt(max(r * r - half * half, 0.0)));
-        let mid = v + 0.5 * (s1 * u1 + s2 * u2);
-        let tt = x21 / max(chord, 1.0e-30);
-        let nn = vec2<f32>(-tt.y, tt.x);
-        let centre_side = dot(nn, -mid);
-        let corner_side = dot(nn, v - mid);
-        if (centre_side * corner_side >= 0.0) {
-            g.area = 0.5 * s1 * s2 * abs(cross2(u1, u2)) + segment_area(r, sag);
-            g.chord = chord;
-            g.point = mid;
-            towards_disk = nn * select(-1.0, 1.0, centre_side + corner_side > 0.0);
-            done = true;
+    if (!done && inside > 0u && cut_any == 0u) {
+        // A run of corners inside (one or more in a row), no other edge cut: the polygon
+        // from the crossing into the run, along it, to the crossing out of it, plus the
+        // minor segment beyond their chord (src/overlap.rs `corner_cap`). The crossings
+        // come from the end corners' exact depths, the polygon's area from integer
+        // offsets about the first crossing; unless the corners inside are not in a row
+        // or the disk's centre lies beyond the chord (a major segment): the general
+        // formula.
+        var first = np;
+        for (var m = 0u; m < np; m++) {
+            let before = (m + np - 1u) % np;
+            if ((mask & (1u << m)) != 0u && (mask & (1u << before)) == 0u) { first = m; }
+        }
+        var count = 0u;
+        if (first < np) {
+            while (count < np && (mask & (1u << ((first + count) % np))) != 0u) { count++; }
+        }
+        if (first < np && count == inside) {
+            let last = (first + count - 1u) % np;
+            let v1 = corner_at(&p, first, vec2<i32>(0));
+            let u1 = normalize(corner_delta(&p, (first + np - 1u) % np, first));
+            let u2 = normalize(corner_delta(&p, (last + 1u) % np, last));
+            let s1 = circle_reach(v1, u1, depth_in_circle(p.w[first], corner_e(&p, first), ru, rr), r);
+            let v2 = corner_at(&p, last, vec2<i32>(0));
+            let s2 = circle_reach(v2, u2, depth_in_circle(p.w[last], corner_e(&p, last), ru, rr), r);
+            var twice = 0.0;
+            var prev = -s1 * u1;
+            for (var k = 1u; k < count; k++) {
+                let next = corner_delta(&p, (first + k) % np, first) - s1 * u1;
+                twice += cross2(prev, next);
+                prev = next;
+            }
+            let x21 = corner_delta(&p, last, first) + s2 * u2 - s1 * u1;
+            twice += cross2(prev, x21);
+            let chord = length(x21);
+            let half = 0.5 * chord;
+            let sag = half * half / (r + sqrt(max(r * r - half * half, 0.0)));
+            let mid = v1 + s1 * u1 + 0.5 * x21;
+            let tt = x21 / max(chord, 1.0e-30);
+            let nn = vec2<f32>(-tt.y, tt.x);
+            let centre_side = dot(nn, -mid);
+            let corner_side = dot(nn, v1 - mid);
+            if (centre_side * corner_side >= 0.0) {
+                g.area = 0.5 * abs(twice) + segment_area(r, sag);
+                g.chord = chord;
+                g.point = mid;
+                towards_disk = nn * select(-1.0, 1.0, centre_side + corner_side > 0.0);
+                done = true;
+            }
         }
     }
     if (!done) {

@@ -339,20 +339,25 @@ pub fn polygon_wall(p: &[P2], w: &WallSegment) -> Option<AreaContact> {
     if area <= 0.0 {
         return None;
     }
-    // Overlap corners on the wall's line: the crossings (or a wall end inside p).
+    // Overlap corners on the wall's line (the crossings, or a wall end inside p), along
+    // the wall from the foot of the centre, not from an end point that may be far.
+    let t = [ab[0] / len, ab[1] / len];
     let mut lo = f64::INFINITY;
     let mut hi = f64::NEG_INFINITY;
     for k in 0..clip.n {
         let (lin, lout) = clip.lines_at(k);
         if lin == WALL_LINE || lout == WALL_LINE {
-            let s = dot(sub(clip.v[k], w.a), ab) / len;
+            let s = dot(clip.v[k], t);
             lo = lo.min(s);
             hi = hi.max(s);
         }
     }
     let (point, chord) = if hi > lo {
-        let s = 0.5 * (lo + hi) / len;
-        ([w.a[0] + s * ab[0], w.a[1] + s * ab[1]], hi - lo)
+        let (dist, mid) = (-dot(m, w.a), 0.5 * (lo + hi));
+        (
+            [-dist * m[0] + mid * t[0], -dist * m[1] + mid * t[1]],
+            hi - lo,
+        )
     } else {
         (corner_mean(clip.corners()), 0.0)
     };
@@ -584,38 +589,61 @@ fn face_segment(a: &P2, b: &P2, c: P2, r: f64) -> Option<DiskOverlap> {
     Some((segment_area(r, delta), chord, point, nout))
 }
 
-/// One corner `corner` inside the circle, `depth` deep, and no other edge cut: the
-/// triangle it cuts off with the circle plus the minor segment beyond the chord. None
-/// when the disk's centre lies beyond the chord (the rest of the disk is then a major
-/// segment, a deep overlap left to the general formula).
-fn corner_cap(v: &[P2], p: &[P2], corner: usize, depth: f64, r: f64) -> Option<DiskOverlap> {
+/// A run of corners inside the circle (one or more in a row, `mask`) and no other edge
+/// cut: the polygon from the crossing on the edge into the run, along the run, to the
+/// crossing on the edge out of it, plus the minor segment beyond the chord between the
+/// two crossings. Everything from the run's own corners (the crossings from the end
+/// corners' depths, the polygon's area about its first crossing), so a small overlap
+/// keeps its relative precision (the general formula loses r² ε). None when the run is
+/// not one (the corners inside are not in a row) or the disk's centre lies beyond the
+/// chord (the rest of the disk is then a major segment): the general formula.
+fn corner_cap(v: &[P2], p: &[P2], mask: u32, r: f64) -> Option<DiskOverlap> {
     let np = p.len();
-    let x = v[corner];
-    let u1 = unit_or_up(sub(p[(corner + np - 1) % np], p[corner]));
-    let u2 = unit_or_up(sub(p[(corner + 1) % np], p[corner]));
-    let k = depth * (2.0 * r - depth); // r² − |v|²
-    // How far along u the edge leaves the circle: s² + 2 b s − k = 0, without cancelling.
-    let reach = |b: f64| {
+    let inside = |m: usize| mask & (1 << (m % np)) != 0;
+    // The run starts at `first` (inside, its predecessor outside) and ends at `last`.
+    let first = (0..np).find(|&m| inside(m) && !inside(m + np - 1))?;
+    let count = (0..np).take_while(|&k| inside(first + k)).count();
+    if count != mask.count_ones() as usize {
+        return None;
+    }
+    let last = (first + count - 1) % np;
+    // How far along u from corner x the edge leaves the circle: s² + 2 b s − k = 0 with
+    // k = r² − |x|² from the corner's depth, without cancelling.
+    let reach = |x: P2, u: P2| {
+        let depth = r - norm(x);
+        let (k, b) = (depth * (2.0 * r - depth), dot(x, u));
         let root = (b * b + k).sqrt();
         if b > 0.0 { k / (b + root) } else { root - b }
     };
-    let (s1, s2) = (reach(dot(x, u1)), reach(dot(x, u2)));
-    // The chord from the corner's own frame: x2 − x1 = s2 u2 − s1 u1.
-    let x21 = [s2 * u2[0] - s1 * u1[0], s2 * u2[1] - s1 * u1[1]];
+    let u1 = unit_or_up(sub(p[(first + np - 1) % np], p[first]));
+    let u2 = unit_or_up(sub(p[(last + 1) % np], p[last]));
+    let (s1, s2) = (reach(v[first], u1), reach(v[last], u2));
+    // Relative to the first crossing x1 = v_first + s1 u1: corner m at p_m − p_first − s1 u1.
+    let from_x1 = |m: usize| sub(sub(p[m], p[first]), [s1 * u1[0], s1 * u1[1]]);
+    let x21 = {
+        let e = from_x1(last);
+        [e[0] + s2 * u2[0], e[1] + s2 * u2[1]]
+    };
+    let mut twice_area = 0.0;
+    let mut prev = from_x1(first);
+    for k in 1..count {
+        let next = from_x1((first + k) % np);
+        twice_area += cross(prev, next);
+        prev = next;
+    }
+    twice_area += cross(prev, x21);
     let chord = norm(x21);
-    let point = [
-        x[0] + 0.5 * (s1 * u1[0] + s2 * u2[0]),
-        x[1] + 0.5 * (s1 * u1[1] + s2 * u2[1]),
-    ];
+    let x1 = [v[first][0] + s1 * u1[0], v[first][1] + s1 * u1[1]];
+    let point = [x1[0] + 0.5 * x21[0], x1[1] + 0.5 * x21[1]];
     let t = [x21[0] / chord.max(1e-300), x21[1] / chord.max(1e-300)];
     let nn = [-t[1], t[0]];
-    let (centre_side, corner_side) = (-dot(nn, point), dot(nn, sub(x, point)));
+    let (centre_side, corner_side) = (-dot(nn, point), dot(nn, sub(v[first], point)));
     if centre_side * corner_side < 0.0 {
         return None;
     }
     let half = 0.5 * chord;
     let sagitta = half * half / (r + (r * r - half * half).max(0.0).sqrt());
-    let area = 0.5 * s1 * s2 * cross(u1, u2).abs() + segment_area(r, sagitta);
+    let area = 0.5 * twice_area.abs() + segment_area(r, sagitta);
     let towards = if centre_side + corner_side > 0.0 {
         nn
     } else {
@@ -674,14 +702,11 @@ pub fn polygon_disk(p: &[P2], c: P2, r: f64, polygon_is_i: bool) -> Option<AreaC
     }
     let v = &v[..np];
     // Corners inside the circle, by their depth r − |v|.
-    let (mut inside, mut mask, mut corner, mut depth) = (0, 0u32, 0, 0.0);
+    let (mut inside, mut mask) = (0, 0u32);
     for (m, x) in v.iter().enumerate() {
-        let dm = r - norm(*x);
-        if dm > 0.0 {
+        if r - norm(*x) > 0.0 {
             inside += 1;
             mask |= 1 << m;
-            corner = m;
-            depth = dm;
         }
     }
     // Edges with both ends outside that the circle cuts (`cut` of them with the disk's
@@ -711,8 +736,8 @@ pub fn polygon_disk(p: &[P2], c: P2, r: f64, polygon_is_i: bool) -> Option<AreaC
     }
     let (area, chord, point, towards_disk) = if inside == 0 && cut == 1 && cut_any == 1 {
         face_segment(&p[edge], &p[(edge + 1) % np], c, r)?
-    } else if let Some(cap) = (inside == 1 && cut_any == 0)
-        .then(|| corner_cap(v, p, corner, depth, r))
+    } else if let Some(cap) = (inside > 0 && cut_any == 0)
+        .then(|| corner_cap(v, p, mask, r))
         .flatten()
     {
         cap
@@ -802,14 +827,16 @@ pub fn disk_wall_area(r: f64, w: &WallSegment) -> Option<AreaContact> {
         return None;
     }
     let h = (delta * (2.0 * r - delta)).sqrt();
+    // The chord's ends relative to the foot of the centre, cut at the wall's ends (not
+    // s ± h, which far along a long wall would round at the size of s).
     let s = -dot(w.a, t);
-    let (lo, hi) = ((s - h).max(0.0), (s + h).min(len));
+    let (lo, hi) = ((-h).max(-s), h.min(len - s));
     if hi <= lo {
         return None;
     }
     let area = segment_area(r, delta) * (hi - lo) / (2.0 * h);
     let mid = 0.5 * (lo + hi);
-    let arm = [w.a[0] + mid * t[0], w.a[1] + mid * t[1]];
+    let arm = [-dist * m[0] + mid * t[0], -dist * m[1] + mid * t[1]];
     let l = norm(arm).max(1e-9 * r);
     Some(AreaContact {
         area,

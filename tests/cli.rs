@@ -99,6 +99,22 @@ fn time_step_too_large_for_the_stiffness() {
 }
 
 #[test]
+fn check_warns_when_resting_overlaps_are_below_the_gpu_resolution() {
+    // Issue 19: the GPU path resolves overlaps to about a position unit (cell/2³⁰ ≈ 1e-9
+    // d), so resting overlaps below ~1e-6 d get forces off by more than 1e-3 there. The
+    // default heap at k_n = 1e9 rests at ~8e-10 d: a warning, not an error.
+    let (code, _, err) = talus(&["check", "--set", "contact.k_n=1e9", "--set", "dt=5e-6"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        err.contains("warning") && err.contains("GPU path resolves overlaps"),
+        "{err}"
+    );
+    // At its own k_n = 2000 it rests at ~4e-4 d: no such warning.
+    let (_, _, err) = talus(&["check"]);
+    assert!(!err.contains("GPU path resolves"), "{err}");
+}
+
+#[test]
 fn unreadable_or_malformed_files() {
     assert_rejected(&["check", "/nonexistent/scene.json"], &["cannot read"]);
     let p = tmp("syntax").join("s.json");

@@ -56,6 +56,13 @@ fn rust_layouts_match_wgsl() {
         };
         assert_eq!(*span as usize, size, "size of {name}");
         assert_eq!(layouter[handle].size as usize, size, "size of {name}");
+        // An empty array (a scene without walls) is bound as a buffer of MIN_BUFFER
+        // bytes, which must hold one element (a 72-byte Wall in a 64-byte buffer failed
+        // validation).
+        assert!(
+            size as u64 <= talus::gpu::MIN_BUFFER,
+            "{name} ({size} B) does not fit the smallest buffer"
+        );
         assert_eq!(members.len(), fields.len(), "field count of {name}");
         for (m, (field, offset)) in members.iter().zip(&fields) {
             assert_eq!(m.name.as_deref(), Some(*field), "field order of {name}");

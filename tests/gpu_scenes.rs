@@ -111,7 +111,13 @@ fn r4_pour_agrees_with_the_cpu_then_statistically() {
         b.kinetic,
         b.contacts
     );
-    assert_eq!(a.particles, b.particles);
+    // Late in the pour the heap reaches the sources (8 d up in a box 10 wide) and a due
+    // particle waits until its spot is free, which depends on the chaotic surface: the
+    // counts may differ by a few (measured 73 against 75 of 75).
+    assert!(
+        (a.particles as f64 - b.particles as f64).abs() <= 0.05 * b.particles as f64,
+        "inserted particles"
+    );
     assert!((a.com[0] - b.com[0]).abs() < 0.5, "centre of mass x");
     assert!(
         (a.com[1] - b.com[1]).abs() < 0.1 * b.com[1],
@@ -478,7 +484,13 @@ fn assert_pour_agrees(name: &str, scene: fn() -> talus::scene::Scene) {
         "{name}, GPU: {} particles, CoM ({:.4}, {:.4}), {} contacts; CPU: {}, ({:.4}, {:.4}), {}",
         a.particles, a.com[0], a.com[1], a.contacts, b.particles, b.com[0], b.com[1], b.contacts
     );
-    assert_eq!(a.particles, b.particles);
+    // Late in the pour the heap reaches the sources (8 d up in a box 10 wide) and a due
+    // particle waits until its spot is free, which depends on the chaotic surface: the
+    // counts may differ by a few (measured 73 against 75 of 75).
+    assert!(
+        (a.particles as f64 - b.particles as f64).abs() <= 0.05 * b.particles as f64,
+        "inserted particles"
+    );
     assert!((a.com[0] - b.com[0]).abs() < 0.5, "centre of mass x");
     assert!(
         (a.com[1] - b.com[1]).abs() < 0.15 * b.com[1],

@@ -131,7 +131,13 @@ pub struct Wall {
     pub b_frac: [u32; 2],
     pub b_rem: [f32; 2],
     pub ab: [f32; 2],
-    pub _pad: [f32; 2],
+    /// The line's unit normal n = (−t_z, t_x), t = (b − a)/|b − a|, in Q30 integers
+    /// (`wall_line` in geometry.wgsl measures distances from the line with it exactly).
+    pub nq: [i32; 2],
+    /// How far that Q30 normal q is turned off n and stretched: q = (1 + α) n + β t,
+    /// β = q·t, α = q·n − 1 (both up to ~2⁻³¹).
+    pub beta: f32,
+    pub alpha: f32,
 }
 
 #[repr(C)]
@@ -248,7 +254,9 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
         fields!(
             Wall,
             "Wall",
-            [a_anchor, a_frac, a_rem, b_anchor, b_frac, b_rem, ab, _pad]
+            [
+                a_anchor, a_frac, a_rem, b_anchor, b_frac, b_rem, ab, nq, beta, alpha
+            ]
         ),
         fields!(Entry, "Entry", [i, j, value, _pad]),
         fields!(Source, "Source", [first, count, inserted, _pad]),

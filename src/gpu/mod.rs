@@ -126,6 +126,10 @@ pub enum GpuError {
     Unsupported(String),
 }
 
+/// The smallest buffer made: an empty array (a scene without walls or sources) must still
+/// hold one element of the largest struct the shaders bind.
+pub const MIN_BUFFER: u64 = 256;
+
 fn ceil_div(a: u64, b: u64) -> u64 {
     a.div_ceil(b)
 }
@@ -306,14 +310,14 @@ impl GpuSimulation {
         let zeroed = |label: &str, bytes: u64| {
             dev.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: bytes.max(64).next_multiple_of(16),
+                size: bytes.max(MIN_BUFFER).next_multiple_of(16),
                 usage: storage,
                 mapped_at_creation: false,
             })
         };
         let init = |label: &str, bytes: &[u8]| {
             let mut v = bytes.to_vec();
-            v.resize(v.len().max(64).next_multiple_of(16), 0);
+            v.resize(v.len().max(MIN_BUFFER as usize).next_multiple_of(16), 0);
             dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
                 contents: &v,
@@ -329,6 +333,7 @@ impl GpuSimulation {
                     position::split2(w.a[0] - origin[0], w.a[1] - origin[1], cell_size);
                 let (b_anchor, b_frac, b_rem) =
                     position::split2(w.b[0] - origin[0], w.b[1] - origin[1], cell_size);
+                let (nq, beta, alpha) = wall_normal(w);
                 Wall {
                     a_anchor,
                     a_frac,
@@ -337,7 +342,9 @@ impl GpuSimulation {
                     b_frac,
                     b_rem,
                     ab: [(w.b[0] - w.a[0]) as f32, (w.b[1] - w.a[1]) as f32],
-                    _pad: [0.0; 2],
+                    nq,
+                    beta,
+                    alpha,
                 }
             })
             .collect();
@@ -988,6 +995,23 @@ impl GpuSimulation {
     pub fn read_contact_out(&self, count: usize) -> Vec<ContactOut> {
         self.read_buffer(&self.buffers.contact_out, 0, count)
     }
+}
+
+/// A wall's line normal n = (−t_z, t_x) (t along a → b) in Q30 integers q, and how q is
+/// off n: q = (1 + α) n + β t, from the f64 end points. With them `wall_line`
+/// (geometry.wgsl) measures distances from any line, long and inclined, exactly in
+/// integers plus α (up to 2⁻³¹) times the distance and β times the distance along it.
+fn wall_normal(w: &crate::geometry::WallSegment) -> ([i32; 2], f32, f32) {
+    let ab = [w.b[0] - w.a[0], w.b[1] - w.a[1]];
+    let len = ab[0].hypot(ab[1]).max(f64::MIN_POSITIVE);
+    let t = [ab[0] / len, ab[1] / len];
+    let n = [-t[1], t[0]];
+    let q30 = (1u64 << 30) as f64;
+    let nq = [(n[0] * q30).round() as i32, (n[1] * q30).round() as i32];
+    let q = [nq[0] as f64 / q30, nq[1] as f64 / q30];
+    let beta = q[0] * t[0] + q[1] * t[1];
+    let alpha = q[0] * n[0] + q[1] * n[1] - 1.0;
+    (nq, beta as f32, alpha as f32)
 }
 
 /// The device's corner buffer: every corner in whole position units, body frame in xy

@@ -197,6 +197,46 @@ fn lightest_mass(scene: &Scene) -> Option<f64> {
         .reduce(f64::min)
 }
 
+/// How finely the GPU path resolves an overlap, in position units (cell/2³⁰): a disk's
+/// overlap is exact to about a unit; a polygon face contact's A/l carries the difference
+/// of the device's corners (whole units, turned by Q31 sin and cos) from the exact
+/// shapes, measured up to 1.4 units (tests/gpu_precision.rs, README "Precision").
+pub const GPU_RESOLUTION_DISKS: f64 = 1.0;
+pub const GPU_RESOLUTION_POLYGONS: f64 = 1.5;
+
+/// A warning when resting contacts would be shallower than the GPU path resolves to
+/// 1e-3 (issue 19): the lightest particle resting on one contact overlaps by m g / k^n
+/// (δ0 (m g/(k^n δ0))^(1/ν) for ν ≠ 1; the continuous laws rest at a separation, not
+/// an overlap, and are not checked).
+fn gpu_resolution_warning(scene: &Scene, law: &ContactLaw) -> Option<String> {
+    let g = scene.gravity.g[0].hypot(scene.gravity.g[1]);
+    let m = lightest_mass(scene)?;
+    let weight = m * g;
+    let (overlap, resolution) = match law {
+        ContactLaw::OverlapArea(l) => (weight / l.k_n, GPU_RESOLUTION_POLYGONS),
+        ContactLaw::SpringDashpot(l) => (
+            l.delta0 * (weight / (l.k_n * l.delta0)).powf(1.0 / l.nu),
+            GPU_RESOLUTION_DISKS,
+        ),
+        ContactLaw::Continuous(_) => return None,
+    };
+    let unit = law.range_factor() * max_diameter(scene) / (1u64 << 30) as f64;
+    let limit = 1e3 * resolution * unit;
+    if overlap.is_nan() || overlap <= 0.0 || overlap >= limit {
+        return None;
+    }
+    Some(format!(
+        "resting contacts overlap by about {overlap:.2e} (m g/k_n for the lightest particle); the GPU path resolves overlaps to about {:.1e} (whole position units of cell/2^30{}), so its contact forces are right to 1e-3 only from overlaps of {limit:.1e} up and may be off by ~{:.0e} here (README, \"Precision\"); the CPU path (f64) has no such limit",
+        resolution * unit,
+        if matches!(law, ContactLaw::OverlapArea(_)) {
+            ", polygon corners"
+        } else {
+            ""
+        },
+        resolution * unit / overlap
+    ))
+}
+
 /// The shortest contact duration t_c = π/ω0 over the particles the scene creates: the
 /// lightest pair (m12 = m_min/2) with the law's stiffness (undamped, so conservative).
 pub fn shortest_contact_time(scene: &Scene, law: &ContactLaw) -> Option<f64> {
@@ -499,6 +539,9 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                     scene.dt * DAMPING_STABILITY / ratio
                 ));
             }
+        }
+        if let Some(w) = gpu_resolution_warning(scene, &law) {
+            warnings.push(w);
         }
         if scene.dt > tc / RECOMMENDED_STEPS_PER_CONTACT {
             warnings.push(format!("dt = {} exceeds t_c/10 = {:.4e} for the stiffest contact; contacts are resolved by fewer than 10 steps", scene.dt, tc / 10.0));

@@ -101,6 +101,18 @@ fn shape(rng: &mut Rng) -> Vec<P2> {
     ellipse_polygon(corners, a, b, rng.range(0.0, std::f64::consts::TAU))
 }
 
+/// A particle's body corners and radius: a random polygon and its circumradius, or a
+/// disk (no corners) of diameter 0.8–1.2.
+fn body(rng: &mut Rng, polygon: bool) -> (Vec<P2>, f64) {
+    if polygon {
+        let v = shape(rng);
+        let r = circumradius(&v);
+        (v, r)
+    } else {
+        (Vec::new(), rng.range(0.4, 0.6))
+    }
+}
+
 /// The outward normal of edge k of corners v (counter-clockwise).
 fn edge_normal(v: &[P2], k: usize) -> P2 {
     let (a, b) = (v[k], v[(k + 1) % v.len()]);
@@ -159,16 +171,7 @@ pub fn pair_set(law: Value, kinds: &[Kind], n: usize, seed: u64) -> PairSet {
             kind,
             Kind::PolygonPolygon | Kind::PolygonDisk | Kind::PolygonWall
         );
-        let body_i = if polygon_i {
-            shape(&mut rng)
-        } else {
-            Vec::new()
-        };
-        let radius_i = if polygon_i {
-            circumradius(&body_i)
-        } else {
-            rng.range(0.4, 0.6)
-        };
+        let (body_i, radius_i) = body(&mut rng, polygon_i);
         let mut theta_i = rng.range(-3.2, 3.2);
         let mut rot_i = Vec::new();
         rotate(&body_i, theta_i, &mut rot_i);
@@ -216,16 +219,7 @@ pub fn pair_set(law: Value, kinds: &[Kind], n: usize, seed: u64) -> PairSet {
             }
             _ => {
                 let polygon_j = matches!(kind, Kind::PolygonPolygon | Kind::DiskPolygon);
-                let body_j = if polygon_j {
-                    shape(&mut rng)
-                } else {
-                    Vec::new()
-                };
-                let radius_j = if polygon_j {
-                    circumradius(&body_j)
-                } else {
-                    rng.range(0.4, 0.6)
-                };
+                let (body_j, radius_j) = body(&mut rng, polygon_j);
                 let mut theta_j = rng.range(-3.2, 3.2);
                 // u: from i towards j.
                 let mut u = unit(rng.range(-3.2, 3.2));
@@ -282,6 +276,72 @@ pub fn pair_set(law: Value, kinds: &[Kind], n: usize, seed: u64) -> PairSet {
         law,
         particles,
         walls,
+        configs,
+        size,
+    }
+}
+
+/// `n` particles resting on one long wall, `length` d long and inclined by `angle`
+/// (radians): polygons (face down or corner first, under the overlap-area law) and disks
+/// in turn, from either end
+/// towards the middle (0.6 d from the ends, then 2 d apart and growing geometrically),
+/// each pushed into it by a gap drawn from `GAPS`.
+pub fn along_a_long_wall(law: Value, length: f64, angle: f64, n: usize, seed: u64) -> PairSet {
+    let mut rng = Rng::new(seed);
+    let t = unit(angle);
+    let m = [-t[1], t[0]];
+    let a = [1.0, 1.0 + length * (-angle.sin()).max(0.0)];
+    let b = [snap(a[0] + length * t[0]), snap(a[1] + length * t[1])];
+    let wall = WallSegment { a, b };
+    let mut particles = Particles::default();
+    let mut configs = Vec::new();
+    for k in 0..n {
+        // From either end in turn, 2 d apart and then farther apart, up to the middle.
+        let j = (k / 2) as f64;
+        let along = (0.6 + 2.0 * j + 0.3 * 1.3f64.powf(j)).min(0.5 * length - 2.0 - j);
+        let s = if k % 2 == 0 { along } else { length - along };
+        let gap = 10f64.powf(rng.range(GAPS[0].log10(), GAPS[1].log10()));
+        let polygons = law["law"] == "overlap_area";
+        let kind = if k % 3 == 2 || !polygons {
+            Kind::DiskWall
+        } else {
+            Kind::PolygonWall
+        };
+        let face = k % 3 == 0;
+        let (body, radius) = body(&mut rng, kind == Kind::PolygonWall);
+        let mut theta = rng.range(-3.2, 3.2);
+        let mut rot = Vec::new();
+        rotate(&body, theta, &mut rot);
+        if face && !body.is_empty() {
+            let e = (rng.next_u64() as usize) % body.len();
+            theta += angle_of([-m[0], -m[1]]) - angle_of(edge_normal(&rot, e));
+            rotate(&body, theta, &mut rot);
+        }
+        let reach = if body.is_empty() {
+            radius
+        } else {
+            rot.iter()
+                .map(|v| -(v[0] * m[0] + v[1] * m[1]))
+                .fold(f64::MIN, f64::max)
+        };
+        let c = [
+            snap(a[0] + s * t[0] + (reach - gap) * m[0]),
+            snap(a[1] + s * t[1] + (reach - gap) * m[1]),
+        ];
+        let i = particles.push_particle(&new_particle(c, theta, body, radius), 1.0, 1.0, 1e-5);
+        configs.push(Config {
+            kind,
+            i: i as usize,
+            face,
+            inclined: true,
+            gap,
+        });
+    }
+    let size = (a[0].max(b[0]) + 2.0).max(a[1].max(b[1]) + 2.0);
+    PairSet {
+        law,
+        particles,
+        walls: vec![wall],
         configs,
         size,
     }
