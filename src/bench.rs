@@ -26,12 +26,22 @@ pub struct Measurement {
     pub steps: u64,
     pub seconds: f64,
     pub particle_steps_per_second: f64,
+    /// CPU path: neighbour-list rebuilds per 1000 steps, and candidate pairs and
+    /// contacts per particle at the end (issue 13).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rebuilds_per_1000_steps: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub pairs_per_particle: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub contacts_per_particle: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
 pub struct Report {
     pub cpu: String,
     pub cores: usize,
+    /// Threads of the CPU path.
+    pub threads: usize,
     pub results: Vec<Measurement>,
 }
 
@@ -105,10 +115,25 @@ fn measure(
     let mut e = engine(sim, backend)?;
     e.advance((steps / 10).max(1)).map_err(|d| d.to_string())?;
     let n0 = e.active_count();
+    let rebuilds0 = match &e {
+        Engine::Cpu(s) => s.neighbours.rebuilds,
+        Engine::Gpu(_) => 0,
+    };
     let t = Instant::now();
     e.advance(steps).map_err(|d| d.to_string())?;
     let seconds = t.elapsed().as_secs_f64();
     let n = (n0 + e.active_count()) / 2;
+    let (rebuilds, pairs, contacts) = match &e {
+        Engine::Cpu(s) => {
+            let per = |k: usize| Some(k as f64 / s.particles.active_count().max(1) as f64);
+            (
+                Some(1000.0 * (s.neighbours.rebuilds - rebuilds0) as f64 / steps as f64),
+                per(s.neighbours.pairs.len()),
+                per(s.pairs.len()),
+            )
+        }
+        Engine::Gpu(_) => (None, None, None),
+    };
     Ok(Measurement {
         workload: workload.into(),
         backend: e.name(),
@@ -121,6 +146,9 @@ fn measure(
         steps,
         seconds,
         particle_steps_per_second: (n * steps) as f64 / seconds.max(1e-12),
+        rebuilds_per_1000_steps: rebuilds,
+        pairs_per_particle: pairs,
+        contacts_per_particle: contacts,
     })
 }
 
@@ -172,8 +200,14 @@ pub fn run(
                 steps
             };
             let m = measure(name, sim, b, k)?;
+            let lists = match (m.rebuilds_per_1000_steps, m.pairs_per_particle) {
+                (Some(r), Some(p)) => {
+                    format!(", {r:.0} rebuilds per 1000 steps, {p:.2} pairs per particle")
+                }
+                _ => String::new(),
+            };
             log(format!(
-                "{:>18} {:>28} {:>7} particles {:>10.3e} particle-steps/s",
+                "{:>18} {:>28} {:>7} particles {:>10.3e} particle-steps/s{lists}",
                 m.workload, m.backend, m.particles, m.particle_steps_per_second
             ));
             results.push(m);
@@ -182,6 +216,7 @@ pub fn run(
     Ok(Report {
         cpu: cpu_name(),
         cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        threads: rayon::current_num_threads(),
         results,
     })
 }

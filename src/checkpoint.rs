@@ -69,9 +69,10 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
         e.u32(corners.len() as u32);
         corners.iter().flatten().for_each(|&v| e.f64(v));
     }
-    e.u64(sim.springs.capacity() as u64);
-    sim.springs.keys.iter().for_each(|&k| e.u64(k));
-    sim.springs.values.iter().for_each(|&v| e.f64(v));
+    let springs = sim.spring_table();
+    e.u64(springs.capacity() as u64);
+    springs.keys.iter().for_each(|&k| e.u64(k));
+    springs.values.iter().for_each(|&v| e.f64(v));
     // From a GPU run: the exact device state, for a bitwise GPU resume. The flag is the
     // device layout's version (1: f32 offsets before fixed point, 2: f32 orientations;
     // neither is read any more).
@@ -96,8 +97,9 @@ pub fn write(sim: &Simulation, path: &Path) -> std::io::Result<()> {
     write_atomic(path, &encode(sim))
 }
 
-/// Loads a checkpoint; `overrides` may change `stop.*` and `output.*` only (so a run can
-/// be extended), since anything else would break the continuation.
+/// Loads a checkpoint; `overrides` may change `stop.*`, `output.*` (so a run can be
+/// extended) and `skin` (which changes only the speed), since anything else would break
+/// the continuation.
 pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| CheckpointError::Io(name.clone(), e))?;
@@ -112,12 +114,12 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
     let scene_text = d.str().map_err(corrupt)?;
     for o in overrides {
         let key = o.split('=').next().unwrap_or("").trim();
-        if !(key.starts_with("stop.") || key.starts_with("output.")) {
+        if !(key.starts_with("stop.") || key.starts_with("output.") || key == "skin") {
             return Err(CheckpointError::Scene(
                 name,
                 crate::scene::SceneError::invalid(
                     key,
-                    "only stop.* and output.* can be changed when resuming",
+                    "only stop.*, output.* and skin can be changed when resuming",
                 ),
             ));
         }

@@ -27,6 +27,10 @@ use talus::{bench, checkpoint, run, scene, sim::Simulation};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Threads of the CPU path (default: every core). Results are bitwise the same for
+    /// any count.
+    #[arg(long, global = true, value_name = "N")]
+    threads: Option<usize>,
 }
 
 #[derive(Subcommand)]
@@ -41,7 +45,7 @@ enum Command {
         /// Override a scene key, e.g. --set contact.mu=0.3 (repeatable).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         overrides: Vec<String>,
-        /// Continue from a checkpoint file (only stop.* and output.* may be --set).
+        /// Continue from a checkpoint file (only stop.*, output.* and skin may be --set).
         #[arg(long, conflicts_with = "scene")]
         resume: Option<PathBuf>,
         #[arg(long, value_enum, default_value_t = Backend::Auto)]
@@ -176,6 +180,15 @@ fn bad_input(message: impl ToString) -> Failure {
 
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global();
+        if n == 0 || pool.is_err() {
+            eprintln!("error: --threads: must be at least 1, got {n}");
+            return ExitCode::from(2);
+        }
+    }
     let result = match cli.command {
         Command::Run {
             scene,

@@ -29,6 +29,30 @@ impl Pair {
     }
 }
 
+/// The broad test of a pair: whether the circumscribed circles are within the law's
+/// range (`range_factor` · σ; a wall: within `range_factor` · r of it). A NaN distance
+/// (a diverged state) is not.
+pub fn circles_touch(
+    particles: &Particles,
+    walls: &[WallSegment],
+    range_factor: f64,
+    pair: Pair,
+) -> bool {
+    let i = pair.i as usize;
+    let g = if pair.is_wall() {
+        let wall = &walls[(pair.j - WALL_BASE) as usize];
+        disk_wall(particles.radius[i], &wall_from(wall, particles.position(i)))
+    } else {
+        let j = pair.j as usize;
+        disk_disk(
+            offset(particles, i, j),
+            particles.radius[i],
+            particles.radius[j],
+        )
+    };
+    !g.r.is_nan() && g.r < range_factor * g.sigma
+}
+
 /// Whether particles i and j interact: disks within `range_factor` · σ, polygons whose
 /// circumscribed circles overlap and whose outlines intersect (SPEC 2.3). Like the
 /// forces, computed from the offset of the pair only.

@@ -12,6 +12,7 @@ use crate::geometry::{
     Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent, wall_from,
 };
 use crate::law::{ContactInput, ContactLaw};
+use crate::neighbours::NeighbourList;
 use crate::overlap::{
     AreaContact, disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall,
 };
@@ -39,6 +40,7 @@ pub struct ContactForce {
 }
 
 /// Stage: forces of every contact, and the updated tangential history.
+#[allow(clippy::too_many_arguments)]
 pub fn contact_forces(
     particles: &Particles,
     corners: &RotatedCorners,
@@ -52,28 +54,106 @@ pub fn contact_forces(
 ) {
     out.clear();
     history_out.clear();
+    let area = matches!(law, ContactLaw::OverlapArea(_));
     for (&pair, &history) in pairs.iter().zip(history_in) {
-        let area = matches!(law, ContactLaw::OverlapArea(_));
         let (g, input) = contact_input(particles, corners, walls, dt, area, pair, history);
-        let res = law.evaluate(&input);
-        let t = tangent(g.n);
-        let force = [
-            res.f_n * g.n[0] + res.f_t * t[0],
-            res.f_n * g.n[1] + res.f_t * t[1],
-        ];
-        let p = particles.position(pair.i as usize);
-        out.push(ContactForce {
-            force,
-            point: [p[0] + g.arm[0], p[1] + g.arm[1]],
-            arm: g.arm,
-            n: g.n,
-            f_n: res.f_n,
-            f_t: res.f_t,
-            overlap: g.delta,
-            energy: res.energy,
-        });
-        history_out.push(res.history);
+        let (c, h) = contact_force(particles, law, pair, &g, &input);
+        out.push(c);
+        history_out.push(h);
     }
+}
+
+/// The law applied to one contact's geometry and kinematics: the force on i and the
+/// updated history.
+fn contact_force(
+    particles: &Particles,
+    law: &ContactLaw,
+    pair: Pair,
+    g: &Geometry,
+    input: &ContactInput,
+) -> (ContactForce, f64) {
+    let res = law.evaluate(input);
+    let t = tangent(g.n);
+    let force = [
+        res.f_n * g.n[0] + res.f_t * t[0],
+        res.f_n * g.n[1] + res.f_t * t[1],
+    ];
+    let p = particles.position(pair.i as usize);
+    let c = ContactForce {
+        force,
+        point: [p[0] + g.arm[0], p[1] + g.arm[1]],
+        arm: g.arm,
+        n: g.n,
+        f_n: res.f_n,
+        f_t: res.f_t,
+        overlap: g.delta,
+        energy: res.energy,
+    };
+    (c, res.history)
+}
+
+/// One candidate of the neighbour list: its contact force and updated history if the
+/// pair touches (the test of `contacts::find_contacts`, and for polygons the same
+/// overlap geometry computed once), None if it does not.
+#[allow(clippy::too_many_arguments)]
+pub fn candidate_force(
+    particles: &Particles,
+    corners: &RotatedCorners,
+    walls: &[WallSegment],
+    law: &ContactLaw,
+    dt: f64,
+    pair: Pair,
+    history: f64,
+) -> Option<(ContactForce, f64)> {
+    if !crate::contacts::circles_touch(particles, walls, law.range_factor(), pair) {
+        return None;
+    }
+    let (g, input) = if matches!(law, ContactLaw::OverlapArea(_)) {
+        let c = area_contact(particles, corners, walls, pair);
+        // Polygons touch when their outlines overlap (disks: when their circles do).
+        let polygon = particles.is_polygon(pair.i as usize)
+            || (!pair.is_wall() && particles.is_polygon(pair.j as usize));
+        if polygon && c.is_none() {
+            return None;
+        }
+        area_kinematics(particles, dt, pair, history, c.unwrap_or_default())
+    } else {
+        contact_input(particles, corners, walls, dt, false, pair, history)
+    };
+    Some(contact_force(particles, law, pair, &g, &input))
+}
+
+/// Stage: every candidate of the neighbour list evaluated on its own, in parallel: its
+/// contact force or None, and its updated history (0 for a candidate not in contact).
+#[allow(clippy::too_many_arguments)]
+pub fn candidate_forces(
+    particles: &Particles,
+    corners: &RotatedCorners,
+    walls: &[WallSegment],
+    law: &ContactLaw,
+    dt: f64,
+    list: &NeighbourList,
+    out: &mut Vec<Option<ContactForce>>,
+    history_out: &mut Vec<f64>,
+) {
+    let n = list.pairs.len();
+    out.resize(n, None);
+    history_out.resize(n, 0.0);
+    crate::parallel::for_each2(out, history_out, |k, c, h| {
+        let r = candidate_force(
+            particles,
+            corners,
+            walls,
+            law,
+            dt,
+            list.pairs[k],
+            list.history[k],
+        );
+        (*c, *h) = match r {
+            Some((f, v)) => (Some(f), v),
+            None => (None, 0.0),
+        };
+    });
 }
 
 /// r_i − r_j: the offset of the pair, the only way positions enter a contact's geometry
@@ -197,8 +277,20 @@ fn area_contact_input(
     pair: Pair,
     history: f64,
 ) -> (Geometry, ContactInput) {
-    let i = pair.i as usize;
     let c = area_contact(particles, corners, walls, pair).unwrap_or_default();
+    area_kinematics(particles, dt, pair, history, c)
+}
+
+/// What the law needs from an area contact's geometry: δ = A/l, its rate and the depth
+/// A/L, and the relative velocity at the force point.
+fn area_kinematics(
+    particles: &Particles,
+    dt: f64,
+    pair: Pair,
+    history: f64,
+    c: AreaContact,
+) -> (Geometry, ContactInput) {
+    let i = pair.i as usize;
     let d = (!pair.is_wall()).then(|| offset(particles, i, pair.j as usize));
     let v1 = particles.velocity(i, dt);
     let s1 = spin_velocity(v1[2], c.arm);
@@ -239,6 +331,39 @@ fn area_contact_input(
         arm: c.arm,
     };
     (g, input)
+}
+
+/// Stage: total contact force and torque (fx, fz, τ) on every particle from the
+/// candidates' results, each particle on its own (in parallel): first the contacts in
+/// which it is the higher id (by increasing partner id), then its own (by increasing
+/// partner, walls last). That is the order in which `reduce_forces` adds them, so the
+/// sums are bitwise the same, whatever the thread count.
+pub fn reduce_candidate_forces(
+    particles: &Particles,
+    list: &NeighbourList,
+    contacts: &[Option<ContactForce>],
+    out: &mut Vec<Dof>,
+) {
+    out.clear();
+    out.resize(particles.len(), [0.0; 3]);
+    crate::parallel::for_each(out, |p, acc| {
+        let down = &list.down[list.down_start[p] as usize..list.down_start[p + 1] as usize];
+        for &k in down {
+            if let Some(c) = &contacts[k as usize] {
+                let i = list.pairs[k as usize].i as usize;
+                let d = offset(particles, i, p);
+                acc[0] -= c.force[0];
+                acc[1] -= c.force[1];
+                acc[2] -= cross([c.arm[0] + d[0], c.arm[1] + d[1]], c.force);
+            }
+        }
+        let own = &contacts[list.start[p] as usize..list.start[p + 1] as usize];
+        for c in own.iter().flatten() {
+            acc[0] += c.force[0];
+            acc[1] += c.force[1];
+            acc[2] += cross(c.arm, c.force);
+        }
+    });
 }
 
 /// Stage: total contact force and torque (fx, fz, τ) on every particle.

@@ -124,14 +124,24 @@ impl RotatedCorners {
 /// current orientation.
 pub fn rotate_corners(particles: &crate::state::Particles, out: &mut RotatedCorners) {
     out.start.clear();
-    out.corners.clear();
-    let mut buf = Vec::new();
-    for i in 0..particles.len() {
-        out.start.push(out.corners.len() as u32);
-        rotate(&particles.shape[i], particles.q[0][i][2], &mut buf);
-        out.corners.extend_from_slice(&buf);
+    let mut total = 0u32;
+    for shape in &particles.shape {
+        out.start.push(total);
+        total += shape.len() as u32;
     }
-    out.start.push(out.corners.len() as u32);
+    out.start.push(total);
+    out.corners.resize(total as usize, [0.0; 2]);
+    if total == 0 {
+        return; // disks only
+    }
+    // Each polygon on its own, on every thread.
+    let start = &out.start;
+    crate::parallel::for_each(&mut out.corners, |k, x| {
+        let i = start.partition_point(|&s| s as usize <= k) - 1;
+        let v = particles.shape[i][k - start[i] as usize];
+        let (s, c) = particles.q[0][i][2].sin_cos();
+        *x = [c * v[0] - s * v[1], s * v[0] + c * v[1]];
+    });
 }
 
 #[cfg(test)]

@@ -2,17 +2,18 @@
 //! like the algorithm. Each stage is a function with a GPU twin of the same name
 //! (ARCHITECTURE.md).
 
-use crate::cell_list::{CellList, Grid};
-use crate::contacts::{Pair, find_contacts};
+use crate::cell_list::Grid;
+use crate::contacts::Pair;
 use crate::create::{self, source::SourceState};
-use crate::forces::{ContactForce, contact_forces, reduce_forces};
+use crate::forces::{ContactForce, candidate_forces, reduce_candidate_forces, reduce_forces};
 use crate::geometry::WallSegment;
 use crate::integrate::{gear, leapfrog};
 use crate::law::ContactLaw;
+use crate::neighbours::{DEFAULT_SKIN, NeighbourList};
 use crate::rng::Rng;
 use crate::scene::{Creation, IntegratorKind, Scene, SceneError};
 use crate::shape::{RotatedCorners, rotate_corners};
-use crate::springs::{SpringTable, gather_history, store_history};
+use crate::springs::{SpringTable, store_history};
 use crate::state::{Dof, Particles};
 
 /// Why a step could not be completed.
@@ -61,6 +62,9 @@ pub struct Simulation {
     pub walls: Vec<WallSegment>,
     pub grid: Grid,
     pub particles: Particles,
+    /// The tangential springs the state was created with (a checkpoint's, or the GPU
+    /// path's at its last download); once the CPU path has stepped, they live in the
+    /// neighbour list (`spring_table` gives them as a table).
     pub springs: SpringTable,
     pub sources: Vec<SourceState>,
     pub rng: Rng,
@@ -70,14 +74,19 @@ pub struct Simulation {
     /// The exact device state when this state came from (or goes to) the GPU path.
     pub device_state: Option<crate::gpu::DeviceState>,
     // Per-step buffers, rebuilt every step (not part of the state).
-    pub cells: CellList,
     /// The polygons' corners turned to their orientations at the current step.
     pub corners: RotatedCorners,
     pub pairs: Vec<Pair>,
     pub contacts: Vec<ContactForce>,
-    history_in: Vec<f64>,
     history_out: Vec<f64>,
     forces: Vec<Dof>,
+    /// The candidate pairs and their springs (issue 13), and this evaluation's result of
+    /// each candidate.
+    pub neighbours: NeighbourList,
+    candidates: Vec<Option<ContactForce>>,
+    candidate_history: Vec<f64>,
+    /// Whether a step has moved the springs into the neighbour list.
+    committed: bool,
 }
 
 impl Simulation {
@@ -136,13 +145,15 @@ impl Simulation {
             step,
             lost,
             device_state: None,
-            cells: CellList::default(),
             corners: RotatedCorners::default(),
             pairs: Vec::new(),
             contacts: Vec::new(),
-            history_in: Vec::new(),
             history_out: Vec::new(),
             forces: Vec::new(),
+            neighbours: NeighbourList::default(),
+            candidates: Vec::new(),
+            candidate_history: Vec::new(),
+            committed: false,
         })
     }
 
@@ -179,34 +190,75 @@ impl Simulation {
             && self.time() >= self.scene.gravity.ramp_time
     }
 
-    /// Stages 2–8 at the current (predicted) state: cell list, rotated corners, contacts,
-    /// their springs from the previous step, and every contact's force. Public for
-    /// measurements and tests of the contacts of a given state; it does not advance.
+    /// The skin of the neighbour list: the scene's, or DEFAULT_SKIN of the largest
+    /// diameter.
+    pub fn skin(&self) -> f64 {
+        self.scene
+            .skin
+            .unwrap_or_else(|| DEFAULT_SKIN * self.largest_diameter())
+    }
+
+    fn largest_diameter(&self) -> f64 {
+        crate::scene::max_diameter(&self.scene).max(2.0 * self.particles.max_radius())
+    }
+
+    /// Stages 2–8 at the current (predicted) state: the neighbour list (rebuilt when a
+    /// particle has moved by half the skin, or was inserted or removed), rotated
+    /// corners, and every candidate's contact and force from its spring of the last
+    /// step. Public for measurements and tests of the contacts of a given state; it does
+    /// not advance and keeps the springs as they were.
     pub fn evaluate_contacts(&mut self) {
-        self.cells
-            .build(&self.grid, &self.particles.q[0], &self.particles.active);
+        if self.neighbours.needs_rebuild(&self.particles) {
+            let d = &self.scene.domain;
+            self.neighbours.rebuild(
+                (d.x, d.z),
+                &self.particles,
+                &self.walls,
+                self.law.range_factor(),
+                self.largest_diameter(),
+                self.skin(),
+                &self.spring_table(),
+            );
+        }
         rotate_corners(&self.particles, &mut self.corners);
-        find_contacts(
-            &self.grid,
-            &self.cells,
-            &self.particles,
-            &self.corners,
-            &self.walls,
-            self.law.range_factor(),
-            &mut self.pairs,
-        );
-        gather_history(&self.springs, &self.pairs, &mut self.history_in);
-        contact_forces(
+        candidate_forces(
             &self.particles,
             &self.corners,
             &self.walls,
             &self.law,
             self.scene.dt,
-            &self.pairs,
-            &self.history_in,
-            &mut self.contacts,
-            &mut self.history_out,
+            &self.neighbours,
+            &mut self.candidates,
+            &mut self.candidate_history,
         );
+        // The contacts, in list order (by i, then j): what find_contacts lists.
+        self.pairs.clear();
+        self.contacts.clear();
+        self.history_out.clear();
+        for ((p, c), h) in self
+            .neighbours
+            .pairs
+            .iter()
+            .zip(&self.candidates)
+            .zip(&self.candidate_history)
+        {
+            if let Some(c) = c {
+                self.pairs.push(*p);
+                self.contacts.push(*c);
+                self.history_out.push(*h);
+            }
+        }
+    }
+
+    /// The tangential springs of the last completed step as a table keyed by pair (for
+    /// checkpoints and the GPU path): the contacts of that step with their springs.
+    pub fn spring_table(&self) -> SpringTable {
+        if !self.committed {
+            return self.springs.clone();
+        }
+        let mut t = SpringTable::default();
+        store_history(&self.pairs, &self.history_out, &mut t);
+        t
     }
 
     /// Starts Gear with the true initial acceleration in q2, (F/m + g) dt²/2 from the
@@ -242,8 +294,8 @@ impl Simulation {
         self.contacts.clear();
     }
 
-    /// One time step: insert, predict, cell list, contacts, springs, forces, reduce,
-    /// correct, boundaries.
+    /// One time step: insert, predict, neighbour list, contacts and forces, springs,
+    /// reduce, correct, boundaries.
     pub fn step(&mut self) -> Result<(), Divergence> {
         let dt = self.scene.dt;
         let t = self.time();
@@ -254,11 +306,13 @@ impl Simulation {
         }
         self.evaluate_contacts();
         self.check_divergence()?;
-        store_history(&self.pairs, &self.history_out, &mut self.springs);
-        reduce_forces(
+        // The candidates' updated springs become the list's.
+        std::mem::swap(&mut self.neighbours.history, &mut self.candidate_history);
+        self.committed = true;
+        reduce_candidate_forces(
             &self.particles,
-            &self.pairs,
-            &self.contacts,
+            &self.neighbours,
+            &self.candidates,
             &mut self.forces,
         );
         if gear {

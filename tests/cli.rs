@@ -278,7 +278,7 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
     ]);
     assert_eq!(code, 2);
     assert!(
-        err.contains("contact.mu") && err.contains("only stop.* and output.*"),
+        err.contains("contact.mu") && err.contains("only stop.*, output.* and skin"),
         "{err}"
     );
 }

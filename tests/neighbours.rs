@@ -1,8 +1,10 @@
-//! The cell list (counting sort) finds exactly the brute-force contacts (SPEC 3).
+//! The cell list (counting sort) finds exactly the brute-force contacts (SPEC 3), and
+//! so do the neighbour lists with a skin between their rebuilds (issue 13).
 
 use talus::cell_list::{CellList, Grid};
-use talus::contacts::{brute_force_contacts, find_contacts};
+use talus::contacts::{brute_force_contacts, find_contacts, interacts, touches_wall};
 use talus::geometry::WallSegment;
+use talus::neighbours::NeighbourList;
 use talus::rng::Rng;
 use talus::shape::{RotatedCorners, circumradius, ellipse_polygon, rotate_corners};
 use talus::state::{NewParticle, Particles};
@@ -79,5 +81,103 @@ fn cell_list_contacts_equal_brute_force() {
     assert!(
         total > 10_000,
         "the packings must be dense enough to test anything ({total})"
+    );
+}
+
+/// The contacts among a neighbour list's candidates, as `find_contacts` tests them.
+fn listed_contacts(
+    list: &NeighbourList,
+    p: &Particles,
+    shapes: &RotatedCorners,
+    walls: &[WallSegment],
+    range: f64,
+) -> Vec<talus::contacts::Pair> {
+    list.pairs
+        .iter()
+        .copied()
+        .filter(|q| {
+            if q.is_wall() {
+                let w = &walls[(q.j - talus::contacts::WALL_BASE) as usize];
+                touches_wall(p, shapes, range, q.i as usize, w)
+            } else {
+                interacts(p, shapes, range, q.i as usize, q.j as usize)
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn neighbour_lists_hold_every_contact_until_a_particle_moves_half_the_skin() {
+    // Issue 13: the candidates listed at a rebuild contain every contact (in the order
+    // find_contacts gives) as long as no particle has moved by more than skin/2; then
+    // `needs_rebuild` says so. Random packings of disks and polygons, moved at random
+    // by up to just below skin/2 (and once by more).
+    let walls = [WallSegment {
+        a: [0.0, 0.3],
+        b: [30.0, 0.3],
+    }];
+    let mut rng = Rng::new(13);
+    let (mut checked, mut moved_contacts) = (0, 0);
+    for seed in 0..12 {
+        let polygons = seed % 2 == 1;
+        let mut p = packing(100 + seed, 400, polygons);
+        let range = if polygons || seed % 4 == 0 { 1.0 } else { 1.2 };
+        let skin = [0.0, 0.1, 0.3, 0.6][(seed % 4) as usize];
+        let mut shapes = RotatedCorners::default();
+        rotate_corners(&p, &mut shapes);
+        let mut list = NeighbourList::default();
+        let table = talus::springs::SpringTable::default();
+        let max_d = 2.0 * p.max_radius();
+        list.rebuild(
+            ([0.0, 30.0], [0.0, 20.0]),
+            &p,
+            &walls,
+            range,
+            max_d,
+            skin,
+            &table,
+        );
+        assert_eq!(
+            listed_contacts(&list, &p, &shapes, &walls, range),
+            brute_force_contacts(&p, &shapes, &walls, range),
+            "seed {seed}: at the rebuild"
+        );
+        if skin == 0.0 {
+            assert!(list.needs_rebuild(&p), "skin 0 rebuilds every step");
+            continue;
+        }
+        assert!(!list.needs_rebuild(&p));
+        // Each particle moves by just under skin/2 in a random direction and turns.
+        let at_rebuild = p.q[0][7];
+        for k in 0..p.len() {
+            let a = rng.range(0.0, std::f64::consts::TAU);
+            let r = 0.4999 * skin * rng.uniform().sqrt();
+            p.q[0][k][0] += r * a.cos();
+            p.q[0][k][1] += r * a.sin();
+            p.q[0][k][2] += rng.range(-1.0, 1.0);
+        }
+        rotate_corners(&p, &mut shapes);
+        assert!(
+            !list.needs_rebuild(&p),
+            "seed {seed}: moved less than skin/2"
+        );
+        let expected = brute_force_contacts(&p, &shapes, &walls, range);
+        assert_eq!(
+            listed_contacts(&list, &p, &shapes, &walls, range),
+            expected,
+            "seed {seed}: after moving"
+        );
+        checked += 1;
+        moved_contacts += expected.len();
+        // One particle a little farther: the list must be rebuilt.
+        p.q[0][7] = [at_rebuild[0] + 0.501 * skin, at_rebuild[1], at_rebuild[2]];
+        assert!(
+            list.needs_rebuild(&p),
+            "seed {seed}: moved more than skin/2"
+        );
+    }
+    assert!(
+        checked >= 6 && moved_contacts > 2000,
+        "{checked} packings, {moved_contacts} contacts"
     );
 }

@@ -367,7 +367,7 @@ impl GpuSimulation {
             None => {
                 let (s, p) = to_device(&sim.particles, origin, cell_size);
                 let e = sim
-                    .springs
+                    .spring_table()
                     .entries()
                     .map(|(k, v)| Entry {
                         i: (k >> 32) as u32,

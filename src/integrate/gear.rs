@@ -7,7 +7,6 @@
 //! Our forces depend on velocities (damping, tangential springs), so c0 = 3/20 — the
 //! variant Allen & Tildesley give for velocity-dependent forces — instead of 3/16.
 
-use super::{acceleration, is_integrated};
 use crate::state::{Dof, GEAR_VALUES, Particles};
 
 /// Corrector coefficients for second-order equations, velocity-dependent forces.
@@ -52,35 +51,31 @@ pub fn correct_one(q: &mut [Dof; GEAR_VALUES], accel: Dof, dt: f64, c: &[f64; GE
     }
 }
 
-fn load(p: &Particles, i: usize) -> [Dof; GEAR_VALUES] {
-    std::array::from_fn(|k| p.q[k][i])
-}
-
-fn store(p: &mut Particles, i: usize, q: &[Dof; GEAR_VALUES]) {
-    for k in 0..GEAR_VALUES {
-        p.q[k][i] = q[k];
-    }
-}
-
-/// Stage: predict every integrated particle.
+/// Stage: predict every integrated particle (each on its own, on every thread).
 pub fn predict(p: &mut Particles) {
-    for i in 0..p.len() {
-        if is_integrated(p, i) {
-            let mut q = load(p, i);
+    let (q, active, fixed) = (&mut p.q, &p.active, &p.fixed);
+    crate::parallel::for_each6(q, |i, v| {
+        if active[i] && !fixed[i] {
+            let mut q = [*v[0], *v[1], *v[2], *v[3], *v[4], *v[5]];
             predict_one(&mut q);
-            store(p, i, &q);
+            for (dst, src) in v.into_iter().zip(q) {
+                *dst = src;
+            }
         }
-    }
+    });
 }
 
 /// Stage: correct every integrated particle with its force at the predicted state.
 pub fn correct(p: &mut Particles, forces: &[Dof], gravity: [f64; 2], dt: f64) {
-    for i in 0..p.len() {
-        if is_integrated(p, i) {
-            let a = acceleration(p, i, forces[i], gravity);
-            let mut q = load(p, i);
+    let (q, active, fixed, mass, inertia) = (&mut p.q, &p.active, &p.fixed, &p.mass, &p.inertia);
+    crate::parallel::for_each6(q, |i, v| {
+        if active[i] && !fixed[i] {
+            let a = super::acceleration(forces[i], mass[i], inertia[i], gravity);
+            let mut q = [*v[0], *v[1], *v[2], *v[3], *v[4], *v[5]];
             correct_one(&mut q, a, dt, &CORRECTOR);
-            store(p, i, &q);
+            for (dst, src) in v.into_iter().zip(q) {
+                *dst = src;
+            }
         }
-    }
+    });
 }

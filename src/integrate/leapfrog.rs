@@ -5,7 +5,7 @@
 //! see the half-step-old velocity, as in the paper's scheme; this is first order in the
 //! damping terms only.
 
-use super::{acceleration, is_integrated};
+use super::acceleration;
 use crate::state::{Dof, Particles};
 
 /// One kick–drift for one particle: q0 = r(t), q1 = dt · v(t − dt/2).
@@ -16,15 +16,15 @@ pub fn kick_drift_one(q0: &mut Dof, q1: &mut Dof, accel: Dof, dt: f64) {
     }
 }
 
-/// Stage: advance every integrated particle with the force at the current positions.
+/// Stage: advance every integrated particle with the force at the current positions
+/// (each on its own, on every thread).
 pub fn kick_drift(p: &mut Particles, forces: &[Dof], gravity: [f64; 2], dt: f64) {
-    for i in 0..p.len() {
-        if is_integrated(p, i) {
-            let a = acceleration(p, i, forces[i], gravity);
-            let (mut q0, mut q1) = (p.q[0][i], p.q[1][i]);
-            kick_drift_one(&mut q0, &mut q1, a, dt);
-            p.q[0][i] = q0;
-            p.q[1][i] = q1;
+    let (active, fixed, mass, inertia) = (&p.active, &p.fixed, &p.mass, &p.inertia);
+    let [q0, q1, ..] = &mut p.q;
+    crate::parallel::for_each2(q0, q1, |i, q0, q1| {
+        if active[i] && !fixed[i] {
+            let a = acceleration(forces[i], mass[i], inertia[i], gravity);
+            kick_drift_one(q0, q1, a, dt);
         }
-    }
+    });
 }

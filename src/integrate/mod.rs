@@ -8,12 +8,13 @@ pub mod leapfrog;
 
 use crate::state::{Dof, Particles};
 
-/// Acceleration (ẍ, z̈, θ̈) of particle i from its summed contact force and torque.
-pub fn acceleration(particles: &Particles, i: usize, force: Dof, gravity: [f64; 2]) -> Dof {
+/// Acceleration (ẍ, z̈, θ̈) of a particle of this mass and moment of inertia from its
+/// summed contact force and torque.
+pub fn acceleration(force: Dof, mass: f64, inertia: f64, gravity: [f64; 2]) -> Dof {
     [
-        force[0] / particles.mass[i] + gravity[0],
-        force[1] / particles.mass[i] + gravity[1],
-        force[2] / particles.inertia[i],
+        force[0] / mass + gravity[0],
+        force[1] / mass + gravity[1],
+        force[2] / inertia,
     ]
 }
 

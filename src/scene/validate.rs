@@ -495,6 +495,9 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
     }
     finite_non_negative("output.log_every", o.log_every)?;
     finite_positive("limits.max_overlap", scene.limits.max_overlap)?;
+    if let Some(skin) = scene.skin {
+        finite_non_negative("skin", skin)?;
+    }
 
     let g = scene.gravity.g;
     let law = ContactLaw::from_spec(&scene.contact, (g[0] * g[0] + g[1] * g[1]).sqrt())?;

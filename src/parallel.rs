@@ -1,0 +1,103 @@
+//! Data parallelism of the CPU path (issue 13): the stages that treat each particle or
+//! each candidate pair on its own run on every thread of the current rayon pool
+//! (`--threads`, default all cores).
+//!
+//! Every item is computed by the same code from the same inputs whichever thread takes
+//! it, and no stage sums across items in parallel (the force reduction sums each
+//! particle's contacts on one thread, in a fixed order), so results are bitwise the same
+//! for any thread count. Small stages stay on the calling thread: waking the pool costs
+//! more than a few thousand items.
+
+use rayon::prelude::*;
+
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Below this many items a stage runs on the calling thread (4096 unless a test lowers
+/// it to run small scenes on every thread).
+static MIN_PARALLEL: AtomicUsize = AtomicUsize::new(4096);
+/// Items per task: at most 512, fewer for a small stage so that every thread gets some.
+fn chunk(n: usize) -> usize {
+    (n / (8 * rayon::current_num_threads())).clamp(1, 512)
+}
+
+/// Sets the smallest stage that runs on every thread (tests: 1, to split small scenes).
+pub fn set_min_parallel(n: usize) {
+    MIN_PARALLEL.store(n, Ordering::Relaxed);
+}
+
+fn parallel(n: usize) -> bool {
+    n >= MIN_PARALLEL.load(Ordering::Relaxed) && rayon::current_num_threads() > 1
+}
+
+/// f(k, &mut v[k]) for every k.
+pub fn for_each<T, F>(v: &mut [T], f: F)
+where
+    T: Send,
+    F: Fn(usize, &mut T) + Sync + Send,
+{
+    if parallel(v.len()) {
+        let c = chunk(v.len());
+        v.par_iter_mut()
+            .enumerate()
+            .with_min_len(c)
+            .for_each(|(k, x)| f(k, x));
+    } else {
+        v.iter_mut().enumerate().for_each(|(k, x)| f(k, x));
+    }
+}
+
+/// f(k, &mut a[k], &mut b[k]) for every k (a and b of equal length).
+pub fn for_each2<A, B, F>(a: &mut [A], b: &mut [B], f: F)
+where
+    A: Send,
+    B: Send,
+    F: Fn(usize, &mut A, &mut B) + Sync + Send,
+{
+    assert_eq!(a.len(), b.len());
+    if parallel(a.len()) {
+        let c = chunk(a.len());
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .enumerate()
+            .with_min_len(c)
+            .for_each(|(k, (x, y))| f(k, x, y));
+    } else {
+        a.iter_mut()
+            .zip(b.iter_mut())
+            .enumerate()
+            .for_each(|(k, (x, y))| f(k, x, y));
+    }
+}
+
+/// f(k, [&mut v0[k], …, &mut v5[k]]) for every k: the six Gear values of a particle.
+pub fn for_each6<T, F>(v: &mut [Vec<T>; 6], f: F)
+where
+    T: Send,
+    F: Fn(usize, [&mut T; 6]) + Sync + Send,
+{
+    let [a, b, c, d, e, g] = v;
+    let n = a.len();
+    if parallel(n) {
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .zip(c.par_iter_mut())
+            .zip(d.par_iter_mut())
+            .zip(e.par_iter_mut())
+            .zip(g.par_iter_mut())
+            .enumerate()
+            .with_min_len(chunk(n))
+            .for_each(|(k, (((((q0, q1), q2), q3), q4), q5))| f(k, [q0, q1, q2, q3, q4, q5]));
+    } else {
+        for (k, (((((q0, q1), q2), q3), q4), q5)) in a
+            .iter_mut()
+            .zip(b.iter_mut())
+            .zip(c.iter_mut())
+            .zip(d.iter_mut())
+            .zip(e.iter_mut())
+            .zip(g.iter_mut())
+            .enumerate()
+        {
+            f(k, [q0, q1, q2, q3, q4, q5]);
+        }
+    }
+}

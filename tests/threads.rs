@@ -1,0 +1,116 @@
+//! The CPU path's neighbour lists and threads change only its speed (issue 13): the same
+//! scene gives bitwise the same state for any skin (a list rebuilt every step, the
+//! default, a large one) and for 1, 2 and 3 threads. Pours with friction (grains land,
+//! slide and roll, contacts open and close between rebuilds) of disks and heptagons,
+//! and a settled packing.
+
+mod common;
+
+use serde_json::json;
+use talus::sim::Simulation;
+
+/// 60 grains with friction poured onto a floor between walls; `skin` as given.
+fn pour(polygons: bool, skin: Option<f64>) -> serde_json::Value {
+    let mut source = json!({ "kind": "point_source", "material": "m", "position": [0.0, 6.0],
+        "spread": 4.0, "rate": 10.0, "count": 60, "velocity": [0.5, -4.0],
+        "diameter": { "uniform": [0.8, 1.2] } });
+    let law = if polygons {
+        source["polygon"] = json!({ "corners": 7, "irregular": true,
+            "axes": [{ "uniform": [0.8, 1.2] }, { "uniform": [0.8, 1.2] }] });
+        source.as_object_mut().unwrap().remove("diameter");
+        json!({ "law": "overlap_area", "k_n": 2000.0, "eta_n": 0.3, "mu": 0.5 })
+    } else {
+        json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 5.0, "k_t": 571.4,
+                "gamma_t": 1.0, "mu": 0.5 })
+    };
+    let mut v = common::scene_value(law, json!([source]));
+    v["dt"] = json!(0.002);
+    v["integrator"] = json!(if polygons { "leapfrog" } else { "gear5" });
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["domain"] = json!({ "x": [-12.0, 12.0], "z": [-2.0, 14.0] });
+    v["walls"] = json!([{ "from": [-8.0, 0.0], "to": [8.0, 0.0] },
+                        { "from": [-8.0, 0.0], "to": [-8.0, 8.0] },
+                        { "from": [8.0, 0.0], "to": [8.0, 8.0] }]);
+    if let Some(s) = skin {
+        v["skin"] = json!(s);
+    }
+    v
+}
+
+fn run(v: &serde_json::Value, steps: usize) -> Simulation {
+    let mut s = common::sim(v);
+    for _ in 0..steps {
+        s.step().unwrap();
+    }
+    s
+}
+
+/// Bitwise equality of two states, naming the first difference.
+fn assert_same(a: &Simulation, b: &Simulation, what: &str) {
+    assert_eq!(
+        a.particles.len(),
+        b.particles.len(),
+        "{what}: particle count"
+    );
+    for k in 0..6 {
+        for (i, (x, y)) in a.particles.q[k].iter().zip(&b.particles.q[k]).enumerate() {
+            assert!(
+                x.iter().zip(y).all(|(u, v)| u.to_bits() == v.to_bits()),
+                "{what}: particle {i}, value q{k}: {x:?} vs {y:?}"
+            );
+        }
+    }
+    assert_eq!(a.pairs, b.pairs, "{what}: contacts");
+    assert_eq!(a.spring_table(), b.spring_table(), "{what}: springs");
+}
+
+#[test]
+fn results_do_not_depend_on_the_skin() {
+    // History lives in the candidates' slots between rebuilds and moves with its pair at
+    // a rebuild: against a list rebuilt every step (skin 0), the default skin and a large
+    // one (fewer rebuilds, more candidates) give bitwise the same pours.
+    for polygons in [false, true] {
+        let steps = 8000;
+        let every = run(&pour(polygons, Some(0.0)), steps);
+        let springs = every.spring_table().len();
+        assert!(springs > 60, "the pour has {springs} springs");
+        let mut rebuilds = vec![every.neighbours.rebuilds];
+        for skin in [None, Some(1.0)] {
+            let s = run(&pour(polygons, skin), steps);
+            assert_same(&every, &s, &format!("polygons {polygons}, skin {skin:?}"));
+            rebuilds.push(s.neighbours.rebuilds);
+        }
+        eprintln!(
+            "polygons {polygons}: {springs} springs; rebuilds with skin 0, default, 1: {rebuilds:?}"
+        );
+        assert!(
+            rebuilds[0] > rebuilds[1] && rebuilds[1] > rebuilds[2],
+            "rebuilds {rebuilds:?}"
+        );
+    }
+}
+
+#[test]
+fn results_do_not_depend_on_the_thread_count() {
+    // Every stage split over the threads even for these small scenes.
+    talus::parallel::set_min_parallel(1);
+    let packing = common::parse(&serde_json::from_str(&talus::bench::packing_scene(600)).unwrap());
+    let scenes = [
+        ("disk pour", pour(false, None), 3000),
+        ("heptagon pour", pour(true, None), 3000),
+        ("packing", serde_json::to_value(packing).unwrap(), 300),
+    ];
+    for (name, v, steps) in scenes {
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| run(&v, steps))
+        };
+        let one = on(1);
+        for threads in [2, 3] {
+            assert_same(&one, &on(threads), &format!("{name}, {threads} threads"));
+        }
+    }
+}
