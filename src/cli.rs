@@ -180,16 +180,28 @@ fn bad_input(message: impl ToString) -> Failure {
 
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
-    if let Some(n) = cli.threads {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global();
-        if n == 0 || pool.is_err() {
-            eprintln!("error: --threads: must be at least 1, got {n}");
+    let threads = match cli.threads {
+        Some(0) => {
+            eprintln!("error: --threads: must be at least 1, got 0");
             return ExitCode::from(2);
         }
-    }
-    let result = match cli.command {
+        Some(n) => n,
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+    };
+    // The command runs on a thread of the pool, so the stages' parallel loops split their
+    // work there instead of handing it over from another thread every time.
+    let pool = match rayon::ThreadPoolBuilder::new().num_threads(threads).build() {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: --threads {threads}: {e}");
+            return ExitCode::from(1);
+        }
+    };
+    pool.install(|| command(cli.command))
+}
+
+fn command(command: Command) -> ExitCode {
+    let result = match command {
         Command::Run {
             scene,
             out,

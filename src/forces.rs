@@ -39,6 +39,23 @@ pub struct ContactForce {
     pub energy: f64,
 }
 
+/// What every contact of a step reads: the state, each particle's velocity (q1/dt,
+/// computed once per step, `velocities`), the rotated corners and the walls.
+#[derive(Clone, Copy)]
+pub struct StepState<'a> {
+    pub particles: &'a Particles,
+    pub velocity: &'a [Dof],
+    pub corners: &'a RotatedCorners,
+    pub walls: &'a [WallSegment],
+    pub dt: f64,
+}
+
+/// Stage: the velocity (vx, vz, ω) = q1/dt of every particle.
+pub fn velocities(particles: &Particles, dt: f64, out: &mut Vec<Dof>) {
+    out.resize(particles.len(), [0.0; 3]);
+    crate::parallel::for_each(out, |i, v| *v = particles.velocity(i, dt));
+}
+
 /// Stage: forces of every contact, and the updated tangential history.
 #[allow(clippy::too_many_arguments)]
 pub fn contact_forces(
@@ -52,11 +69,20 @@ pub fn contact_forces(
     out: &mut Vec<ContactForce>,
     history_out: &mut Vec<f64>,
 ) {
+    let mut velocity = Vec::new();
+    velocities(particles, dt, &mut velocity);
+    let s = StepState {
+        particles,
+        velocity: &velocity,
+        corners,
+        walls,
+        dt,
+    };
     out.clear();
     history_out.clear();
     let area = matches!(law, ContactLaw::OverlapArea(_));
     for (&pair, &history) in pairs.iter().zip(history_in) {
-        let (g, input) = contact_input(particles, corners, walls, dt, area, pair, history);
+        let (g, input) = contact_input(&s, area, pair, history);
         let (c, h) = contact_force(particles, law, pair, &g, &input);
         out.push(c);
         history_out.push(h);
@@ -65,6 +91,7 @@ pub fn contact_forces(
 
 /// The law applied to one contact's geometry and kinematics: the force on i and the
 /// updated history.
+#[inline(always)]
 fn contact_force(
     particles: &Particles,
     law: &ContactLaw,
@@ -93,45 +120,44 @@ fn contact_force(
 }
 
 /// One candidate of the neighbour list: its contact force and updated history if the
-/// pair touches (the test of `contacts::find_contacts`, and for polygons the same
-/// overlap geometry computed once), None if it does not.
-#[allow(clippy::too_many_arguments)]
+/// pair touches (the test of `contacts::find_contacts`, with the geometry computed once:
+/// the disks' for the disk laws, the overlap for polygons), None if it does not.
+#[inline(always)]
 pub fn candidate_force(
-    particles: &Particles,
-    corners: &RotatedCorners,
-    walls: &[WallSegment],
+    s: &StepState,
     law: &ContactLaw,
-    dt: f64,
     pair: Pair,
     history: f64,
 ) -> Option<(ContactForce, f64)> {
-    if !crate::contacts::circles_touch(particles, walls, law.range_factor(), pair) {
-        return None;
-    }
     let (g, input) = if matches!(law, ContactLaw::OverlapArea(_)) {
-        let c = area_contact(particles, corners, walls, pair);
+        if !crate::contacts::circles_touch(s.particles, s.walls, law.range_factor(), pair) {
+            return None;
+        }
+        let c = area_contact(s.particles, s.corners, s.walls, pair);
         // Polygons touch when their outlines overlap (disks: when their circles do).
-        let polygon = particles.is_polygon(pair.i as usize)
-            || (!pair.is_wall() && particles.is_polygon(pair.j as usize));
+        let p = s.particles;
+        let polygon =
+            p.is_polygon(pair.i as usize) || (!pair.is_wall() && p.is_polygon(pair.j as usize));
         if polygon && c.is_none() {
             return None;
         }
-        area_kinematics(particles, dt, pair, history, c.unwrap_or_default())
+        area_kinematics(s, pair, history, c.unwrap_or_default())
     } else {
-        contact_input(particles, corners, walls, dt, false, pair, history)
+        let (g, d) = disk_geometry(s, pair);
+        // A NaN distance (a diverged state) interacts with nothing.
+        if g.r.is_nan() || g.r >= law.range_factor() * g.sigma {
+            return None;
+        }
+        disk_kinematics(s, pair, history, g, d)
     };
-    Some(contact_force(particles, law, pair, &g, &input))
+    Some(contact_force(s.particles, law, pair, &g, &input))
 }
 
 /// Stage: every candidate of the neighbour list evaluated on its own, in parallel: its
 /// contact force or None, and its updated history (0 for a candidate not in contact).
-#[allow(clippy::too_many_arguments)]
 pub fn candidate_forces(
-    particles: &Particles,
-    corners: &RotatedCorners,
-    walls: &[WallSegment],
+    s: &StepState,
     law: &ContactLaw,
-    dt: f64,
     list: &NeighbourList,
     out: &mut Vec<Option<ContactForce>>,
     history_out: &mut Vec<f64>,
@@ -140,15 +166,7 @@ pub fn candidate_forces(
     out.resize(n, None);
     history_out.resize(n, 0.0);
     crate::parallel::for_each2(out, history_out, |k, c, h| {
-        let r = candidate_force(
-            particles,
-            corners,
-            walls,
-            law,
-            dt,
-            list.pairs[k],
-            list.history[k],
-        );
+        let r = candidate_force(s, law, list.pairs[k], list.history[k]);
         (*c, *h) = match r {
             Some((f, v)) => (Some(f), v),
             None => (None, 0.0),
@@ -158,6 +176,7 @@ pub fn candidate_forces(
 
 /// r_i − r_j: the offset of the pair, the only way positions enter a contact's geometry
 /// (issue 18).
+#[inline]
 pub fn offset(particles: &Particles, i: usize, j: usize) -> [f64; 2] {
     let (pi, pj) = (particles.position(i), particles.position(j));
     [pi[0] - pj[0], pi[1] - pj[1]]
@@ -167,21 +186,26 @@ pub fn offset(particles: &Particles, i: usize, j: usize) -> [f64; 2] {
 /// frame at particle i's centre (`Geometry::arm`).
 /// `area`: the overlap-area law, which sees every pair (disks too) by its overlap area.
 pub fn contact_input(
-    particles: &Particles,
-    corners: &RotatedCorners,
-    walls: &[WallSegment],
-    dt: f64,
+    s: &StepState,
     area: bool,
     pair: Pair,
     history: f64,
 ) -> (Geometry, ContactInput) {
-    let i = pair.i as usize;
     if area {
-        return area_contact_input(particles, corners, walls, dt, pair, history);
+        let c = area_contact(s.particles, s.corners, s.walls, pair).unwrap_or_default();
+        return area_kinematics(s, pair, history, c);
     }
-    let v1 = particles.velocity(i, dt);
-    let (g, d) = if pair.is_wall() {
-        let wall = &walls[(pair.j - WALL_BASE) as usize];
+    let (g, d) = disk_geometry(s, pair);
+    disk_kinematics(s, pair, history, g, d)
+}
+
+/// The disk laws' geometry of a pair (disk–disk or disk–wall), and the offset r_i − r_j
+/// of a particle pair.
+#[inline(always)]
+fn disk_geometry(s: &StepState, pair: Pair) -> (Geometry, Option<[f64; 2]>) {
+    let (particles, i) = (s.particles, pair.i as usize);
+    if pair.is_wall() {
+        let wall = &s.walls[(pair.j - WALL_BASE) as usize];
         let w = wall_from(wall, particles.position(i));
         (disk_wall(particles.radius[i], &w), None)
     } else {
@@ -189,13 +213,26 @@ pub fn contact_input(
         let d = offset(particles, i, j);
         let g = disk_disk(d, particles.radius[i], particles.radius[j]);
         (g, Some(d))
-    };
+    }
+}
+
+/// What a disk law needs from the geometry g: the relative velocity of the two surfaces
+/// at the contact point (rotation included), along n and t, and the masses.
+#[inline(always)]
+fn disk_kinematics(
+    s: &StepState,
+    pair: Pair,
+    history: f64,
+    g: Geometry,
+    d: Option<[f64; 2]>,
+) -> (Geometry, ContactInput) {
+    let i = pair.i as usize;
+    let v1 = s.velocity[i];
     let s1 = spin_velocity(v1[2], g.arm);
-    let (v2, m2) = material_velocity(particles, dt, pair, g.arm, d);
-    // Relative velocity of the two surfaces at the contact point (rotation included).
+    let (v2, m2) = material_velocity(s, pair, g.arm, d);
     let v12 = [v1[0] + s1[0] - v2[0], v1[1] + s1[1] - v2[1]];
     let t = tangent(g.n);
-    let m1 = particles.mass[i];
+    let m1 = s.particles.mass[i];
     let (m12, mass) = if m2.is_infinite() {
         (m1, m1)
     } else {
@@ -211,16 +248,16 @@ pub fn contact_input(
         m12,
         mass,
         history,
-        dt,
+        dt: s.dt,
     };
     (g, input)
 }
 
 /// Velocity of particle j's material at the contact point (zero for a wall), and its
 /// mass. The point is `arm` from r_i, so `arm + d` from r_j (d = r_i − r_j).
+#[inline(always)]
 fn material_velocity(
-    particles: &Particles,
-    dt: f64,
+    s: &StepState,
     pair: Pair,
     arm: [f64; 2],
     d: Option<[f64; 2]>,
@@ -229,9 +266,9 @@ fn material_velocity(
         return ([0.0, 0.0], f64::INFINITY);
     };
     let j = pair.j as usize;
-    let v = particles.velocity(j, dt);
-    let s = spin_velocity(v[2], [arm[0] + d[0], arm[1] + d[1]]);
-    ([v[0] + s[0], v[1] + s[1]], particles.mass[j])
+    let v = s.velocity[j];
+    let w = spin_velocity(v[2], [arm[0] + d[0], arm[1] + d[1]]);
+    ([v[0] + w[0], v[1] + w[1]], s.particles.mass[j])
 }
 
 /// The overlap-area geometry of a pair (SPEC 2.3), whatever the shapes, in the frame of
@@ -265,36 +302,23 @@ pub fn area_contact(
     }
 }
 
-/// Geometry and kinematics of a polygon contact (SPEC 2.3, src/law/overlap_area.rs): the
-/// law sees δ = A/l, its rate L v_n / l and the depth A/L. A pair that no longer
-/// overlaps (possible only between finding and evaluating, which see the same state)
-/// gives zero input.
-fn area_contact_input(
-    particles: &Particles,
-    corners: &RotatedCorners,
-    walls: &[WallSegment],
-    dt: f64,
-    pair: Pair,
-    history: f64,
-) -> (Geometry, ContactInput) {
-    let c = area_contact(particles, corners, walls, pair).unwrap_or_default();
-    area_kinematics(particles, dt, pair, history, c)
-}
-
-/// What the law needs from an area contact's geometry: δ = A/l, its rate and the depth
-/// A/L, and the relative velocity at the force point.
+/// What the overlap-area law needs from an area contact's geometry (SPEC 2.3,
+/// src/law/overlap_area.rs): δ = A/l, its rate L v_n / l and the depth A/L, and the
+/// relative velocity at the force point. A pair that no longer overlaps (possible only
+/// between finding and evaluating, which see the same state) gives zero input.
+#[inline(always)]
 fn area_kinematics(
-    particles: &Particles,
-    dt: f64,
+    s: &StepState,
     pair: Pair,
     history: f64,
     c: AreaContact,
 ) -> (Geometry, ContactInput) {
+    let (particles, dt) = (s.particles, s.dt);
     let i = pair.i as usize;
     let d = (!pair.is_wall()).then(|| offset(particles, i, pair.j as usize));
-    let v1 = particles.velocity(i, dt);
+    let v1 = s.velocity[i];
     let s1 = spin_velocity(v1[2], c.arm);
-    let (v2, m2) = material_velocity(particles, dt, pair, c.arm, d);
+    let (v2, m2) = material_velocity(s, pair, c.arm, d);
     let v12 = [v1[0] + s1[0] - v2[0], v1[1] + s1[1] - v2[1]];
     let t = tangent(c.n);
     let m1 = particles.mass[i];

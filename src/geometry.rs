@@ -26,22 +26,26 @@ pub struct Geometry {
 }
 
 /// Tangent t = (−n_z, n_x): n rotated by +90°.
+#[inline]
 pub fn tangent(n: [f64; 2]) -> [f64; 2] {
     [-n[1], n[0]]
 }
 
 /// 2D cross product a × b (the z component).
+#[inline]
 pub fn cross(a: [f64; 2], b: [f64; 2]) -> f64 {
     a[0] * b[1] - a[1] * b[0]
 }
 
 /// ω ẑ × l.
+#[inline]
 pub fn spin_velocity(omega: f64, l: [f64; 2]) -> [f64; 2] {
     [-omega * l[1], omega * l[0]]
 }
 
 /// A wall seen from the point c: its end points relative to c. Contacts with walls are
 /// computed in this frame, never from absolute coordinates (issue 18).
+#[inline]
 pub fn wall_from(w: &WallSegment, c: [f64; 2]) -> WallSegment {
     WallSegment {
         a: [w.a[0] - c[0], w.a[1] - c[1]],
@@ -50,6 +54,7 @@ pub fn wall_from(w: &WallSegment, c: [f64; 2]) -> WallSegment {
 }
 
 /// Two disks whose centres are d = r1 − r2 apart: δ = (d1 + d2)/2 − |d| (paper 000 sec. 2.1).
+#[inline]
 pub fn disk_disk(d: [f64; 2], r1: f64, r2: f64) -> Geometry {
     let r = (d[0] * d[0] + d[1] * d[1]).sqrt();
     // Coincident centres: any direction is as good; pick +z so the force stays finite.
@@ -73,6 +78,7 @@ pub fn disk_disk(d: [f64; 2], r1: f64, r2: f64) -> Geometry {
 /// A disk and a wall segment `w` given relative to the disk's centre ([`wall_from`]):
 /// δ = R − distance to the closest point of the segment. The continuous laws see the
 /// mirror disk behind the wall: r = 2·distance, σ = 2R.
+#[inline]
 pub fn disk_wall(radius: f64, w: &WallSegment) -> Geometry {
     let ab = [w.b[0] - w.a[0], w.b[1] - w.a[1]];
     let len2 = ab[0] * ab[0] + ab[1] * ab[1];

@@ -5,7 +5,9 @@
 use crate::cell_list::Grid;
 use crate::contacts::Pair;
 use crate::create::{self, source::SourceState};
-use crate::forces::{ContactForce, candidate_forces, reduce_candidate_forces, reduce_forces};
+use crate::forces::{
+    ContactForce, StepState, candidate_forces, reduce_candidate_forces, velocities,
+};
 use crate::geometry::WallSegment;
 use crate::integrate::{gear, leapfrog};
 use crate::law::ContactLaw;
@@ -13,7 +15,7 @@ use crate::neighbours::{DEFAULT_SKIN, NeighbourList};
 use crate::rng::Rng;
 use crate::scene::{Creation, IntegratorKind, Scene, SceneError};
 use crate::shape::{RotatedCorners, rotate_corners};
-use crate::springs::{SpringTable, store_history};
+use crate::springs::SpringTable;
 use crate::state::{Dof, Particles};
 
 /// Why a step could not be completed.
@@ -78,13 +80,17 @@ pub struct Simulation {
     pub corners: RotatedCorners,
     pub pairs: Vec<Pair>,
     pub contacts: Vec<ContactForce>,
-    history_out: Vec<f64>,
     forces: Vec<Dof>,
     /// The candidate pairs and their springs (issue 13), and this evaluation's result of
     /// each candidate.
     pub neighbours: NeighbourList,
     candidates: Vec<Option<ContactForce>>,
     candidate_history: Vec<f64>,
+    /// Whether a step lists its contacts in `pairs` and `contacts` (default; a run
+    /// turns it off for the steps between its outputs).
+    pub record_contacts: bool,
+    /// Every particle's velocity q1/dt at the evaluated state.
+    velocity: Vec<Dof>,
     /// Whether a step has moved the springs into the neighbour list.
     committed: bool,
 }
@@ -148,11 +154,12 @@ impl Simulation {
             corners: RotatedCorners::default(),
             pairs: Vec::new(),
             contacts: Vec::new(),
-            history_out: Vec::new(),
             forces: Vec::new(),
             neighbours: NeighbourList::default(),
             candidates: Vec::new(),
             candidate_history: Vec::new(),
+            record_contacts: true,
+            velocity: Vec::new(),
             committed: false,
         })
     }
@@ -221,31 +228,30 @@ impl Simulation {
             );
         }
         rotate_corners(&self.particles, &mut self.corners);
+        velocities(&self.particles, self.scene.dt, &mut self.velocity);
+        let state = StepState {
+            particles: &self.particles,
+            velocity: &self.velocity,
+            corners: &self.corners,
+            walls: &self.walls,
+            dt: self.scene.dt,
+        };
         candidate_forces(
-            &self.particles,
-            &self.corners,
-            &self.walls,
+            &state,
             &self.law,
-            self.scene.dt,
             &self.neighbours,
             &mut self.candidates,
             &mut self.candidate_history,
         );
-        // The contacts, in list order (by i, then j): what find_contacts lists.
+        // The contacts, in list order (by i, then j): what find_contacts lists. Only
+        // when someone will look (outputs between the steps of a run need none).
         self.pairs.clear();
         self.contacts.clear();
-        self.history_out.clear();
-        for ((p, c), h) in self
-            .neighbours
-            .pairs
-            .iter()
-            .zip(&self.candidates)
-            .zip(&self.candidate_history)
-        {
-            if let Some(c) = c {
+        if self.record_contacts {
+            let listed = self.neighbours.pairs.iter().zip(&self.candidates);
+            for (p, c) in listed.filter_map(|(p, c)| c.as_ref().map(|c| (p, c))) {
                 self.pairs.push(*p);
                 self.contacts.push(*c);
-                self.history_out.push(*h);
             }
         }
     }
@@ -256,9 +262,8 @@ impl Simulation {
         if !self.committed {
             return self.springs.clone();
         }
-        let mut t = SpringTable::default();
-        store_history(&self.pairs, &self.history_out, &mut t);
-        t
+        let in_contact: Vec<bool> = self.candidates.iter().map(Option::is_some).collect();
+        self.neighbours.table(&in_contact)
     }
 
     /// Starts Gear with the true initial acceleration in q2, (F/m + g) dt²/2 from the
@@ -270,10 +275,10 @@ impl Simulation {
             return;
         }
         self.evaluate_contacts();
-        reduce_forces(
+        reduce_candidate_forces(
             &self.particles,
-            &self.pairs,
-            &self.contacts,
+            &self.neighbours,
+            &self.candidates,
             &mut self.forces,
         );
         let g = self.gravity(0.0);
@@ -370,7 +375,8 @@ impl Simulation {
 
     fn check_divergence(&self) -> Result<(), Divergence> {
         let limit = self.scene.limits.max_overlap;
-        for (pair, c) in self.pairs.iter().zip(&self.contacts) {
+        let contacts = self.neighbours.pairs.iter().zip(&self.candidates);
+        for (pair, c) in contacts.filter_map(|(p, c)| c.as_ref().map(|c| (p, c))) {
             let ri = self.particles.radius[pair.i as usize];
             let rmin = if pair.is_wall() {
                 ri

@@ -89,11 +89,13 @@ impl Particles {
         id
     }
 
+    #[inline]
     pub fn position(&self, i: usize) -> [f64; 2] {
         [self.q[0][i][0], self.q[0][i][1]]
     }
 
     /// Velocity (vx, vz, ω) from the scaled first derivative.
+    #[inline]
     pub fn velocity(&self, i: usize, dt: f64) -> Dof {
         let q = self.q[1][i];
         [q[0] / dt, q[1] / dt, q[2] / dt]

@@ -88,6 +88,7 @@ impl ContactLaw {
         input_r < self.range_factor() * sigma
     }
 
+    #[inline(always)]
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         match self {
             Self::SpringDashpot(l) => l.evaluate(c),
@@ -118,6 +119,7 @@ impl ContactLaw {
 /// Clamps a normal force to be non-negative: a non-cohesive contact never attracts
 /// (SPEC 2). Applied after damping is added, so a fast-separating contact carries zero
 /// force instead of pulling the grains together.
+#[inline]
 pub fn clamp_non_negative(f_n: f64) -> f64 {
     f_n.max(0.0)
 }

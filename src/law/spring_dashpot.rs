@@ -66,6 +66,7 @@ impl SpringDashpot {
         })
     }
 
+    #[inline(always)]
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         let f_el = elastic_force(self.k_n, self.delta0, self.nu, c.delta);
         let f_diss = dissipative_force(self.gamma_n, self.delta0, self.psi, c.delta, c.delta_dot);
@@ -99,6 +100,7 @@ impl SpringDashpot {
 }
 
 /// f_el = k_n δ0 (δ/δ0)^ν, paper 000 eq. 2.
+#[inline(always)]
 pub fn elastic_force(k_n: f64, delta0: f64, nu: f64, delta: f64) -> f64 {
     if nu == 1.0 {
         k_n * delta
@@ -108,6 +110,7 @@ pub fn elastic_force(k_n: f64, delta0: f64, nu: f64, delta: f64) -> f64 {
 }
 
 /// f_diss = γ_n δ̇ (δ/δ0)^ψ, paper 000 eq. 3.
+#[inline(always)]
 pub fn dissipative_force(gamma_n: f64, delta0: f64, psi: f64, delta: f64, delta_dot: f64) -> f64 {
     if psi == 0.0 {
         gamma_n * delta_dot
@@ -117,6 +120,7 @@ pub fn dissipative_force(gamma_n: f64, delta0: f64, psi: f64, delta: f64, delta_
 }
 
 /// ∫0^δ f_el = k_n δ0² (δ/δ0)^(ν+1) / (ν+1).
+#[inline(always)]
 pub fn elastic_energy(k_n: f64, delta0: f64, nu: f64, delta: f64) -> f64 {
     let x = delta / delta0;
     // x² for the linear law: what powf(x, 2) gives (both correctly rounded), without

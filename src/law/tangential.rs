@@ -9,6 +9,7 @@
 /// When the cap is reached the contact slides and the spring is shortened so that
 /// k_t |ξ| = μ f_n (paper 000 after eq. 5). With k_t = 0 it is pure viscous friction,
 /// still capped. Returns (f_t, new ξ).
+#[inline(always)]
 pub fn coulomb_spring(
     xi: f64,
     v_t: f64,
@@ -30,6 +31,7 @@ pub fn coulomb_spring(
 }
 
 /// Elastic energy of the tangential spring, k_t ξ² / 2.
+#[inline(always)]
 pub fn spring_energy(k_t: f64, xi: f64) -> f64 {
     0.5 * k_t * xi * xi
 }
