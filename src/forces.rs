@@ -11,7 +11,7 @@ use crate::contacts::{Pair, WALL_BASE};
 use crate::geometry::{
     Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent, wall_from,
 };
-use crate::law::{ContactInput, ContactLaw};
+use crate::law::{ContactInput, ContactLaw, ContactOutput, Law};
 use crate::neighbours::NeighbourList;
 use crate::overlap::{
     AreaContact, disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall,
@@ -83,7 +83,7 @@ pub fn contact_forces(
     let area = matches!(law, ContactLaw::OverlapArea(_));
     for (&pair, &history) in pairs.iter().zip(history_in) {
         let (g, input) = contact_input(&s, area, pair, history);
-        let (c, h) = contact_force(particles, law, pair, &g, &input);
+        let (c, h) = contact_force(particles, |c| law.evaluate(c), pair, &g, &input);
         out.push(c);
         history_out.push(h);
     }
@@ -94,12 +94,12 @@ pub fn contact_forces(
 #[inline(always)]
 fn contact_force(
     particles: &Particles,
-    law: &ContactLaw,
+    evaluate: impl Fn(&ContactInput) -> ContactOutput,
     pair: Pair,
     g: &Geometry,
     input: &ContactInput,
 ) -> (ContactForce, f64) {
-    let res = law.evaluate(input);
+    let res = evaluate(input);
     let t = tangent(g.n);
     let force = [
         res.f_n * g.n[0] + res.f_t * t[0],
@@ -123,13 +123,13 @@ fn contact_force(
 /// pair touches (the test of `contacts::find_contacts`, with the geometry computed once:
 /// the disks' for the disk laws, the overlap for polygons), None if it does not.
 #[inline(always)]
-pub fn candidate_force(
+pub fn candidate_force<L: Law>(
     s: &StepState,
-    law: &ContactLaw,
+    law: &L,
     pair: Pair,
     history: f64,
 ) -> Option<(ContactForce, f64)> {
-    let (g, input) = if matches!(law, ContactLaw::OverlapArea(_)) {
+    let (g, input) = if L::AREA {
         if !crate::contacts::circles_touch(s.particles, s.walls, law.range_factor(), pair) {
             return None;
         }
@@ -150,11 +150,18 @@ pub fn candidate_force(
         }
         disk_kinematics(s, pair, history, g, d)
     };
-    Some(contact_force(s.particles, law, pair, &g, &input))
+    Some(contact_force(
+        s.particles,
+        |c| law.evaluate(c),
+        pair,
+        &g,
+        &input,
+    ))
 }
 
 /// Stage: every candidate of the neighbour list evaluated on its own, in parallel: its
 /// contact force or None, and its updated history (0 for a candidate not in contact).
+/// The loop is specialised to the law.
 pub fn candidate_forces(
     s: &StepState,
     law: &ContactLaw,
@@ -165,6 +172,20 @@ pub fn candidate_forces(
     let n = list.pairs.len();
     out.resize(n, None);
     history_out.resize(n, 0.0);
+    match law {
+        ContactLaw::SpringDashpot(l) => candidates_with(s, l, list, out, history_out),
+        ContactLaw::OverlapArea(l) => candidates_with(s, l, list, out, history_out),
+        ContactLaw::Continuous(l) => candidates_with(s, l, list, out, history_out),
+    }
+}
+
+fn candidates_with<L: Law>(
+    s: &StepState,
+    law: &L,
+    list: &NeighbourList,
+    out: &mut [Option<ContactForce>],
+    history_out: &mut [f64],
+) {
     crate::parallel::for_each2(out, history_out, |k, c, h| {
         let r = candidate_force(s, law, list.pairs[k], list.history[k]);
         (*c, *h) = match r {

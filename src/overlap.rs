@@ -24,6 +24,7 @@
 
 use crate::geometry::{WallSegment, cross};
 use crate::shape::{MAX_CORNERS, P2};
+use std::cell::RefCell;
 
 /// Most corners an overlap polygon can have: each clipping half-plane adds at most one.
 pub const MAX_CLIP: usize = 2 * MAX_CORNERS as usize + 4;
@@ -56,14 +57,25 @@ impl Default for Clip {
     }
 }
 
+thread_local! {
+    /// Scratch polygons for the clipping, one set per thread: the overlap of every
+    /// contact is computed every step, and zeroing fresh 36-corner buffers each time
+    /// cost as much as the clipping itself.
+    static SCRATCH: RefCell<[Clip; 3]> = RefCell::new([Clip::default(); 3]);
+}
+
+/// Runs f with this thread's scratch polygons.
+fn with_scratch<R>(f: impl FnOnce(&mut [Clip; 3]) -> R) -> R {
+    SCRATCH.with(|s| f(&mut s.borrow_mut()))
+}
+
 impl Clip {
-    /// A polygon's outline: edge k on line `first_line + k`.
-    fn outline(p: &[P2], first_line: u32) -> Self {
-        let mut c = Self::default();
+    /// Becomes a polygon's outline: edge k on line `first_line + k`.
+    fn set_outline(&mut self, p: &[P2], first_line: u32) {
+        self.n = 0;
         for (k, x) in p.iter().enumerate() {
-            c.push(*x, first_line + k as u32);
+            self.push(*x, first_line + k as u32);
         }
-        c
     }
 
     pub fn corners(&self) -> &[P2] {
@@ -72,7 +84,8 @@ impl Clip {
 
     /// The lines of the edges into and out of corner k.
     fn lines_at(&self, k: usize) -> (u32, u32) {
-        (self.line[(k + self.n - 1) % self.n], self.line[k])
+        let before = if k == 0 { self.n - 1 } else { k - 1 };
+        (self.line[before], self.line[k])
     }
 
     fn push(&mut self, x: P2, line: u32) {
@@ -115,8 +128,10 @@ fn norm(a: P2) -> f64 {
 fn clip_lines(src: &Clip, a: P2, m: P2, id: u32, dst: &mut Clip) {
     dst.n = 0;
     let n = src.n;
+    // Edge e runs from corner e to the next, the last back to the first (no modulo: an
+    // integer division for every corner of every clip cost more than the clip).
     for e in 0..n {
-        let (x, y) = (src.v[e], src.v[(e + 1) % n]);
+        let (x, y) = (src.v[e], src.v[if e + 1 == n { 0 } else { e + 1 }]);
         let (dx, dy) = (dot(sub(x, a), m), dot(sub(y, a), m));
         if dx >= 0.0 {
             dst.push(x, src.line[e]);
@@ -161,8 +176,9 @@ fn in_frame_of_i(q: &[P2], d: P2) -> ([P2; MAX_CORNERS as usize], usize) {
 /// convex and counter-clockwise in i's frame. The lines of the clipped polygon's edges
 /// tell where each of its corners comes from; the crossings come out of the clipping,
 /// with no extra search.
-fn clip_by(p: &[P2], q: &[P2]) -> Clip {
-    let mut buf = [Clip::outline(p, 0), Clip::default()];
+/// Returns which of `buf`'s first two polygons holds the result.
+fn clip_by(p: &[P2], q: &[P2], buf: &mut [Clip; 3]) -> usize {
+    buf[0].set_outline(p, 0);
     let mut cur = 0;
     // p lies in the circle of radius r about its centre: an edge line of q that keeps
     // the whole circle inside clips nothing, one that keeps it all outside leaves no
@@ -170,7 +186,7 @@ fn clip_by(p: &[P2], q: &[P2]) -> Clip {
     let r = p.iter().map(|v| dot(*v, *v)).fold(0.0, f64::max).sqrt();
     let nq = q.len();
     for k in 0..nq {
-        let (a, b) = (q[k], q[(k + 1) % nq]);
+        let (a, b) = (q[k], q[if k + 1 == nq { 0 } else { k + 1 }]);
         let m = [-(b[1] - a[1]), b[0] - a[0]];
         let reach = r * norm(m);
         let centre = -dot(a, m);
@@ -181,7 +197,7 @@ fn clip_by(p: &[P2], q: &[P2]) -> Clip {
             buf[cur].n = 0;
             break;
         }
-        let [x, y] = &mut buf;
+        let [x, y, _] = buf;
         let (src, dst) = if cur == 0 { (&*x, y) } else { (&*y, x) };
         clip_lines(src, a, m, Q_LINE + k as u32, dst);
         cur = 1 - cur;
@@ -189,7 +205,7 @@ fn clip_by(p: &[P2], q: &[P2]) -> Clip {
             break;
         }
     }
-    buf[cur]
+    cur
 }
 
 /// The overlap area of polygons p (corners relative to r_i) and q (relative to r_j),
@@ -197,11 +213,13 @@ fn clip_by(p: &[P2], q: &[P2]) -> Clip {
 /// as [`polygon_polygon`].
 pub fn overlap_area(p: &[P2], q: &[P2], d: P2) -> f64 {
     let (q, nq) = in_frame_of_i(q, d);
-    let o = clip_by(p, &q[..nq]);
-    if o.n < 3 {
-        return 0.0;
-    }
-    crate::shape::area(o.corners())
+    with_scratch(|buf| {
+        let o = &buf[clip_by(p, &q[..nq], buf)];
+        if o.n < 3 {
+            return 0.0;
+        }
+        crate::shape::area(o.corners())
+    })
 }
 
 /// Mean of the corners: the fallback force point. Unlike the area centroid it needs no
@@ -249,7 +267,22 @@ fn unit_or_up(d: P2) -> P2 {
 /// the outlines do not overlap.
 pub fn polygon_polygon(p: &[P2], q: &[P2], d: P2) -> Option<AreaContact> {
     let (qi, nq) = in_frame_of_i(q, d);
-    let clip = clip_by(p, &qi[..nq]);
+    with_scratch(|buf| {
+        let k = clip_by(p, &qi[..nq], buf);
+        let [x, y, crossed] = buf;
+        overlap_contact(if k == 0 { x } else { y }, crossed, p, q, d)
+    })
+}
+
+/// The contact of the overlap polygon `clip` of p and q (d = r_i − r_j); `crossed` is
+/// scratch space.
+fn overlap_contact(
+    clip: &Clip,
+    crossed: &mut Clip,
+    p: &[P2],
+    q: &[P2],
+    d: P2,
+) -> Option<AreaContact> {
     if clip.n < 3 {
         return None;
     }
@@ -262,7 +295,7 @@ pub fn polygon_polygon(p: &[P2], q: &[P2], d: P2) -> Option<AreaContact> {
         let (lin, lout) = clip.lines_at(k);
         origin_of(lin, lout)
     };
-    let mut crossed = Clip::default();
+    crossed.n = 0;
     for (k, x) in overlap.iter().enumerate() {
         if origin(k) == Origin::Crossing {
             crossed.push(*x, 0);
@@ -326,15 +359,23 @@ pub fn polygon_wall(p: &[P2], w: &WallSegment) -> Option<AreaContact> {
     if dot(m, w.a) > 0.0 {
         m = [-m[0], -m[1]];
     }
-    let mut cur = Clip::outline(p, 0);
-    let mut next = Clip::default();
-    clip_lines(&cur, w.a, [-m[0], -m[1]], WALL_LINE, &mut next);
-    clip_lines(&next, w.a, ab, END_A_LINE, &mut cur);
-    clip_lines(&cur, w.b, [-ab[0], -ab[1]], END_B_LINE, &mut next);
-    if next.n < 3 {
+    with_scratch(|buf| {
+        let [cur, next, _] = buf;
+        cur.set_outline(p, 0);
+        clip_lines(cur, w.a, [-m[0], -m[1]], WALL_LINE, next);
+        clip_lines(next, w.a, ab, END_A_LINE, cur);
+        clip_lines(cur, w.b, [-ab[0], -ab[1]], END_B_LINE, next);
+        wall_contact(next, p, w, m)
+    })
+}
+
+/// The contact of the part `clip` of p beyond the wall w (m: its normal towards the
+/// centre).
+fn wall_contact(clip: &Clip, p: &[P2], w: &WallSegment, m: P2) -> Option<AreaContact> {
+    if clip.n < 3 {
         return None;
     }
-    let clip = next;
+    let (ab, len) = (sub(w.b, w.a), norm(sub(w.b, w.a)));
     let area = crate::shape::area(clip.corners());
     if area <= 0.0 {
         return None;

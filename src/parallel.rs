@@ -101,3 +101,18 @@ where
         }
     }
 }
+
+/// The first k in 0..n for which f(k) holds (the same k whatever the thread count).
+pub fn position_first<F>(n: usize, f: F) -> Option<usize>
+where
+    F: Fn(usize) -> bool + Sync + Send,
+{
+    if parallel(n) {
+        (0..n)
+            .into_par_iter()
+            .with_min_len(chunk(n))
+            .position_first(f)
+    } else {
+        (0..n).position(f)
+    }
+}

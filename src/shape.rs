@@ -112,6 +112,11 @@ pub fn rotate(v: &[P2], theta: f64, out: &mut Vec<P2>) {
 pub struct RotatedCorners {
     pub start: Vec<u32>,
     pub corners: Vec<P2>,
+    /// Which particle each corner belongs to, every body corner in one array, and each
+    /// particle's (sin θ, cos θ): laid out again only when particles were added.
+    owner: Vec<u32>,
+    body: Vec<P2>,
+    turn: Vec<[f64; 2]>,
 }
 
 impl RotatedCorners {
@@ -121,25 +126,37 @@ impl RotatedCorners {
 }
 
 /// Stage (twin of `rotate_corners` in orientation.wgsl): every polygon's corners at its
-/// current orientation.
+/// current orientation, R(θ) v, on every thread.
 pub fn rotate_corners(particles: &crate::state::Particles, out: &mut RotatedCorners) {
-    out.start.clear();
-    let mut total = 0u32;
-    for shape in &particles.shape {
-        out.start.push(total);
-        total += shape.len() as u32;
+    if out.start.len() != particles.len() + 1 {
+        // Shapes never change; only new particles add corners.
+        out.start.clear();
+        out.owner.clear();
+        out.body.clear();
+        for (i, shape) in particles.shape.iter().enumerate() {
+            out.start.push(out.body.len() as u32);
+            out.body.extend_from_slice(shape);
+            out.owner.extend(std::iter::repeat_n(i as u32, shape.len()));
+        }
+        out.start.push(out.body.len() as u32);
+        out.corners.resize(out.body.len(), [0.0; 2]);
     }
-    out.start.push(total);
-    out.corners.resize(total as usize, [0.0; 2]);
-    if total == 0 {
+    if out.body.is_empty() {
         return; // disks only
     }
-    // Each polygon on its own, on every thread.
-    let start = &out.start;
+    out.turn.resize(particles.len(), [0.0; 2]);
+    let q = &particles.q[0];
+    let shapes = &particles.shape;
+    crate::parallel::for_each(&mut out.turn, |i, sc| {
+        if !shapes[i].is_empty() {
+            let (s, c) = q[i][2].sin_cos();
+            *sc = [s, c];
+        }
+    });
+    let (owner, body, turn) = (&out.owner, &out.body, &out.turn);
     crate::parallel::for_each(&mut out.corners, |k, x| {
-        let i = start.partition_point(|&s| s as usize <= k) - 1;
-        let v = particles.shape[i][k - start[i] as usize];
-        let (s, c) = particles.q[0][i][2].sin_cos();
+        let [s, c] = turn[owner[k] as usize];
+        let v = body[k];
         *x = [c * v[0] - s * v[1], s * v[0] + c * v[1]];
     });
 }

@@ -375,42 +375,50 @@ impl Simulation {
 
     fn check_divergence(&self) -> Result<(), Divergence> {
         let limit = self.scene.limits.max_overlap;
-        let contacts = self.neighbours.pairs.iter().zip(&self.candidates);
-        for (pair, c) in contacts.filter_map(|(p, c)| c.as_ref().map(|c| (p, c))) {
+        let list = &self.neighbours;
+        // A contact's overlap relative to the smaller radius.
+        let ratio = |k: usize, c: &ContactForce| {
+            let pair = list.pairs[k];
             let ri = self.particles.radius[pair.i as usize];
             let rmin = if pair.is_wall() {
                 ri
             } else {
                 ri.min(self.particles.radius[pair.j as usize])
             };
+            c.overlap / rmin
+        };
+        let bad = |k: usize| {
+            self.candidates[k].as_ref().is_some_and(|c| {
+                !(c.force[0].is_finite() && c.force[1].is_finite()) || ratio(k, c) > limit
+            })
+        };
+        if let Some(k) = crate::parallel::position_first(self.candidates.len(), bad) {
+            let (pair, c) = (list.pairs[k], self.candidates[k].as_ref().unwrap());
             if !(c.force[0].is_finite() && c.force[1].is_finite()) {
                 return Err(Divergence::NotFinite {
                     id: pair.i,
                     what: "contact force",
                 });
             }
-            let ratio = c.overlap / rmin;
-            if ratio > limit {
-                let j = if pair.is_wall() {
-                    format!("wall {}", pair.j - crate::contacts::WALL_BASE)
-                } else {
-                    pair.j.to_string()
-                };
-                return Err(Divergence::Overlap {
-                    i: pair.i,
-                    j,
-                    ratio,
-                    limit,
-                });
-            }
+            let j = if pair.is_wall() {
+                format!("wall {}", pair.j - crate::contacts::WALL_BASE)
+            } else {
+                pair.j.to_string()
+            };
+            return Err(Divergence::Overlap {
+                i: pair.i,
+                j,
+                ratio: ratio(k, c),
+                limit,
+            });
         }
-        for i in 0..self.particles.len() {
-            if self.particles.active[i] && !self.particles.q[0][i].iter().all(|v| v.is_finite()) {
-                return Err(Divergence::NotFinite {
-                    id: i as u32,
-                    what: "position",
-                });
-            }
+        let p = &self.particles;
+        let lost = |i: usize| p.active[i] && !p.q[0][i].iter().all(|v| v.is_finite());
+        if let Some(i) = crate::parallel::position_first(p.len(), lost) {
+            return Err(Divergence::NotFinite {
+                id: i as u32,
+                what: "position",
+            });
         }
         Ok(())
     }

@@ -123,10 +123,12 @@ pub fn dissipative_force(gamma_n: f64, delta0: f64, psi: f64, delta: f64, delta_
 #[inline(always)]
 pub fn elastic_energy(k_n: f64, delta0: f64, nu: f64, delta: f64) -> f64 {
     let x = delta / delta0;
-    // x² for the linear law: what powf(x, 2) gives (both correctly rounded), without
-    // its cost on every contact of every step.
-    let power = if nu == 1.0 { x * x } else { x.powf(nu + 1.0) };
-    k_n * delta0 * delta0 * power / (nu + 1.0)
+    // The linear law without powf and the division: x² is what powf(x, 2) gives (both
+    // correctly rounded), and halving is exact, so the value is the same to the bit.
+    if nu == 1.0 {
+        return k_n * delta0 * delta0 * (x * x) * 0.5;
+    }
+    k_n * delta0 * delta0 * x.powf(nu + 1.0) / (nu + 1.0)
 }
 
 pub(crate) fn positive(path: &str, v: f64) -> Result<f64, SceneError> {
