@@ -18,12 +18,16 @@ use crate::overlap::{
 };
 use crate::shape::RotatedCorners;
 use crate::state::{Dof, Particles};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The result of one contact, kept for outputs and the reduction.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ContactForce {
     /// Total force on particle i (−force acts on j).
     pub force: [f64; 2],
+    /// Its torques: about i's centre, arm × F, and about j's, (arm + r_i − r_j) × F (the
+    /// torque on j is minus that; 0 for a wall).
+    pub torque: [f64; 2],
     /// Contact point, where both forces act (world coordinates, for outputs).
     pub point: [f64; 2],
     /// The contact point relative to particle i's centre: the branch vector the torques
@@ -105,9 +109,17 @@ fn contact_force(
         res.f_n * g.n[0] + res.f_t * t[0],
         res.f_n * g.n[1] + res.f_t * t[1],
     ];
-    let p = particles.position(pair.i as usize);
+    let i = pair.i as usize;
+    let p = particles.position(i);
+    let torque_j = if pair.is_wall() {
+        0.0
+    } else {
+        let d = offset(particles, i, pair.j as usize);
+        cross([g.arm[0] + d[0], g.arm[1] + d[1]], force)
+    };
     let c = ContactForce {
         force,
+        torque: [cross(g.arm, force), torque_j],
         point: [p[0] + g.arm[0], p[1] + g.arm[1]],
         arm: g.arm,
         n: g.n,
@@ -159,23 +171,44 @@ pub fn candidate_force<L: Law>(
     ))
 }
 
+/// Whether a contact shows a diverging state: a non-finite force, or an overlap beyond
+/// `max_overlap` of the smaller radius (limits.max_overlap).
+pub fn diverges(particles: &Particles, pair: Pair, c: &ContactForce, max_overlap: f64) -> bool {
+    !(c.force[0].is_finite() && c.force[1].is_finite())
+        || overlap_ratio(particles, pair, c) > max_overlap
+}
+
+/// A contact's overlap relative to the smaller radius.
+pub fn overlap_ratio(particles: &Particles, pair: Pair, c: &ContactForce) -> f64 {
+    let ri = particles.radius[pair.i as usize];
+    let rmin = if pair.is_wall() {
+        ri
+    } else {
+        ri.min(particles.radius[pair.j as usize])
+    };
+    c.overlap / rmin
+}
+
 /// Stage: every candidate of the neighbour list evaluated on its own, in parallel: its
 /// contact force or None, and its updated history (0 for a candidate not in contact).
-/// The loop is specialised to the law.
+/// The loop is specialised to the law. Returns the first candidate whose contact
+/// diverges (`diverges`), if any.
 pub fn candidate_forces(
     s: &StepState,
     law: &ContactLaw,
     list: &NeighbourList,
+    max_overlap: f64,
     out: &mut Vec<Option<ContactForce>>,
     history_out: &mut Vec<f64>,
-) {
+) -> Option<usize> {
     let n = list.pairs.len();
     out.resize(n, None);
     history_out.resize(n, 0.0);
+    let f = (out, history_out);
     match law {
-        ContactLaw::SpringDashpot(l) => candidates_with(s, l, list, out, history_out),
-        ContactLaw::OverlapArea(l) => candidates_with(s, l, list, out, history_out),
-        ContactLaw::Continuous(l) => candidates_with(s, l, list, out, history_out),
+        ContactLaw::SpringDashpot(l) => candidates_with(s, l, list, max_overlap, f.0, f.1),
+        ContactLaw::OverlapArea(l) => candidates_with(s, l, list, max_overlap, f.0, f.1),
+        ContactLaw::Continuous(l) => candidates_with(s, l, list, max_overlap, f.0, f.1),
     }
 }
 
@@ -183,16 +216,27 @@ fn candidates_with<L: Law>(
     s: &StepState,
     law: &L,
     list: &NeighbourList,
+    max_overlap: f64,
     out: &mut [Option<ContactForce>],
     history_out: &mut [f64],
-) {
+) -> Option<usize> {
+    // The first diverging candidate: the smallest index, whichever thread finds it.
+    let first = AtomicUsize::new(usize::MAX);
     crate::parallel::for_each2(out, history_out, |k, c, h| {
-        let r = candidate_force(s, law, list.pairs[k], list.history[k]);
+        let pair = list.pairs[k];
+        let r = candidate_force(s, law, pair, list.history[k]);
         (*c, *h) = match r {
-            Some((f, v)) => (Some(f), v),
+            Some((f, v)) => {
+                if diverges(s.particles, pair, &f, max_overlap) {
+                    first.fetch_min(k, Ordering::Relaxed);
+                }
+                (Some(f), v)
+            }
             None => (None, 0.0),
         };
     });
+    let k = first.into_inner();
+    (k != usize::MAX).then_some(k)
 }
 
 /// r_i − r_j: the offset of the pair, the only way positions enter a contact's geometry
@@ -395,18 +439,16 @@ pub fn reduce_candidate_forces(
         let down = &list.down[list.down_start[p] as usize..list.down_start[p + 1] as usize];
         for &k in down {
             if let Some(c) = &contacts[k as usize] {
-                let i = list.pairs[k as usize].i as usize;
-                let d = offset(particles, i, p);
                 acc[0] -= c.force[0];
                 acc[1] -= c.force[1];
-                acc[2] -= cross([c.arm[0] + d[0], c.arm[1] + d[1]], c.force);
+                acc[2] -= c.torque[1];
             }
         }
         let own = &contacts[list.start[p] as usize..list.start[p + 1] as usize];
         for c in own.iter().flatten() {
             acc[0] += c.force[0];
             acc[1] += c.force[1];
-            acc[2] += cross(c.arm, c.force);
+            acc[2] += c.torque[0];
         }
     });
 }

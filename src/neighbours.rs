@@ -19,7 +19,7 @@
 //! A list built for the first time takes the values from the spring table the state was
 //! created with (a checkpoint's).
 
-use crate::cell_list::{CellList, Grid};
+use crate::cell_list::Grid;
 use crate::contacts::{Pair, WALL_BASE};
 use crate::geometry::{WallSegment, disk_wall, wall_from};
 use crate::springs::{SpringTable, pair_key};
@@ -43,9 +43,11 @@ pub struct NeighbourList {
     /// Positions at the last rebuild, and which particles were active then.
     at: Vec<Dof>,
     active: Vec<bool>,
-    /// The grid of the rebuilds: cells of at least range + skin.
+    /// The grid of the rebuilds: cells of at least range + skin, and the active
+    /// particles sorted by cell (a sparse cell list: memory and time O(N), whatever the
+    /// domain's area).
     grid: Option<Grid>,
-    cells: CellList,
+    cells: Vec<(u64, u32)>,
     /// The skin of the last rebuild.
     pub skin: f64,
     /// How many times the list was built.
@@ -89,7 +91,7 @@ impl NeighbourList {
             Some(g) if g.cell_size >= reach => g.clone(),
             _ => Grid::new(domain.0, domain.1, reach),
         };
-        self.cells.build(&grid, &particles.q[0], &particles.active);
+        sort_by_cell(&grid, particles, &mut self.cells);
         let mut pairs = Vec::with_capacity(self.pairs.len().max(4 * particles.len()));
         let mut start = Vec::with_capacity(particles.len() + 1);
         list_candidates(
@@ -143,12 +145,44 @@ impl NeighbourList {
     }
 }
 
+/// A cell's key: its row, then its column (u64: a domain 10⁵ diameters square has 10¹⁰
+/// cells).
+fn cell_key(grid: &Grid, x: u32, z: u32) -> u64 {
+    z as u64 * grid.nx as u64 + x as u64
+}
+
+/// Every active particle as (cell key, id), sorted: by cell, and by id within a cell.
+fn sort_by_cell(grid: &Grid, particles: &Particles, out: &mut Vec<(u64, u32)>) {
+    out.clear();
+    for (i, p) in particles.q[0].iter().enumerate() {
+        if particles.active[i] {
+            let (x, z) = grid.cell_coords([p[0], p[1]]);
+            out.push((cell_key(grid, x, z), i as u32));
+        }
+    }
+    out.sort_unstable();
+}
+
+/// The particles of the cells x0..=x1 of row z: one run of the sorted list.
+fn row_of_cells<'a>(
+    grid: &Grid,
+    cells: &'a [(u64, u32)],
+    x0: u32,
+    x1: u32,
+    z: u32,
+) -> &'a [(u64, u32)] {
+    let (lo, hi) = (cell_key(grid, x0, z), cell_key(grid, x1, z));
+    let a = cells.partition_point(|c| c.0 < lo);
+    let b = a + cells[a..].partition_point(|c| c.0 <= hi);
+    &cells[a..b]
+}
+
 /// The candidates of every active particle, in contact order, and where each particle's
 /// start. A pair of two fixed particles is never a candidate (neither moves).
 #[allow(clippy::too_many_arguments)]
 fn list_candidates(
     grid: &Grid,
-    cells: &CellList,
+    cells: &[(u64, u32)],
     particles: &Particles,
     walls: &[WallSegment],
     range_factor: f64,
@@ -165,9 +199,11 @@ fn list_candidates(
         let pi = [pos[i][0], pos[i][1]];
         let (cx, cz) = grid.cell_coords(pi);
         let first = out.len();
+        let (x0, x1) = (cx.saturating_sub(1), (cx + 1).min(grid.nx - 1));
         for z in cz.saturating_sub(1)..=(cz + 1).min(grid.nz - 1) {
-            for x in cx.saturating_sub(1)..=(cx + 1).min(grid.nx - 1) {
-                for &j in cells.cell(grid, x, z) {
+            {
+                // The three cells x0..=x1 of a row are one run of the sorted list.
+                for &(_, j) in row_of_cells(grid, cells, x0, x1, z) {
                     let ju = j as usize;
                     if ju <= i || (particles.fixed[i] && particles.fixed[ju]) {
                         continue;

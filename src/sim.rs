@@ -6,7 +6,7 @@ use crate::cell_list::Grid;
 use crate::contacts::Pair;
 use crate::create::{self, source::SourceState};
 use crate::forces::{
-    ContactForce, StepState, candidate_forces, reduce_candidate_forces, velocities,
+    ContactForce, StepState, candidate_forces, overlap_ratio, reduce_candidate_forces, velocities,
 };
 use crate::geometry::WallSegment;
 use crate::integrate::{gear, leapfrog};
@@ -93,6 +93,8 @@ pub struct Simulation {
     velocity: Vec<Dof>,
     /// Whether a step has moved the springs into the neighbour list.
     committed: bool,
+    /// The first candidate whose contact diverges at the last evaluation.
+    diverging: Option<usize>,
 }
 
 impl Simulation {
@@ -161,6 +163,7 @@ impl Simulation {
             record_contacts: true,
             velocity: Vec::new(),
             committed: false,
+            diverging: None,
         })
     }
 
@@ -236,10 +239,11 @@ impl Simulation {
             walls: &self.walls,
             dt: self.scene.dt,
         };
-        candidate_forces(
+        self.diverging = candidate_forces(
             &state,
             &self.law,
             &self.neighbours,
+            self.scene.limits.max_overlap,
             &mut self.candidates,
             &mut self.candidate_history,
         );
@@ -375,25 +379,11 @@ impl Simulation {
 
     fn check_divergence(&self) -> Result<(), Divergence> {
         let limit = self.scene.limits.max_overlap;
-        let list = &self.neighbours;
-        // A contact's overlap relative to the smaller radius.
-        let ratio = |k: usize, c: &ContactForce| {
-            let pair = list.pairs[k];
-            let ri = self.particles.radius[pair.i as usize];
-            let rmin = if pair.is_wall() {
-                ri
-            } else {
-                ri.min(self.particles.radius[pair.j as usize])
-            };
-            c.overlap / rmin
-        };
-        let bad = |k: usize| {
-            self.candidates[k].as_ref().is_some_and(|c| {
-                !(c.force[0].is_finite() && c.force[1].is_finite()) || ratio(k, c) > limit
-            })
-        };
-        if let Some(k) = crate::parallel::position_first(self.candidates.len(), bad) {
-            let (pair, c) = (list.pairs[k], self.candidates[k].as_ref().unwrap());
+        if let Some(k) = self.diverging {
+            let pair = self.neighbours.pairs[k];
+            let c = self.candidates[k]
+                .as_ref()
+                .expect("a diverging candidate is a contact");
             if !(c.force[0].is_finite() && c.force[1].is_finite()) {
                 return Err(Divergence::NotFinite {
                     id: pair.i,
@@ -408,7 +398,7 @@ impl Simulation {
             return Err(Divergence::Overlap {
                 i: pair.i,
                 j,
-                ratio: ratio(k, c),
+                ratio: overlap_ratio(&self.particles, pair, c),
                 limit,
             });
         }

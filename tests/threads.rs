@@ -114,3 +114,16 @@ fn results_do_not_depend_on_the_thread_count() {
         }
     }
 }
+
+#[test]
+fn a_domain_a_hundred_thousand_diameters_square_runs() {
+    // Issue 13: the cell search was a dense grid over the whole domain (10¹⁰ cells here:
+    // the run aborted on memory). The neighbour list sorts the particles by cell instead,
+    // in memory and time proportional to the particles: the pour lands as in a tight box.
+    let mut huge = pour(false, None);
+    huge["domain"] = json!({ "x": [-5e4, 5e4], "z": [-5e4, 5e4] });
+    let tight = pour(false, None);
+    let (a, b) = (run(&huge, 6000), run(&tight, 6000));
+    assert!(a.pairs.len() > 40, "{} contacts", a.pairs.len());
+    assert_same(&a, &b, "the same pour in a huge domain");
+}

@@ -889,6 +889,9 @@ impl GpuSimulation {
                 pairs.push(Pair { i: i as u32, j });
                 contacts.push(ContactForce {
                     force: [o.ft[0] as f64, o.ft[1] as f64],
+                    // contact_out holds the torque on j; ContactForce the torque of F
+                    // about j's centre.
+                    torque: [o.ft[2] as f64, -(o.ft[3] as f64)],
                     point: [p[0] + arm[0], p[1] + arm[1]],
                     arm,
                     n: [o.geo[0] as f64, o.geo[1] as f64],
