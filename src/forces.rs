@@ -173,42 +173,68 @@ pub fn candidate_force<L: Law>(
 
 /// Whether a contact shows a diverging state: a non-finite force, or an overlap beyond
 /// `max_overlap` of the smaller radius (limits.max_overlap).
+#[inline(always)]
 pub fn diverges(particles: &Particles, pair: Pair, c: &ContactForce, max_overlap: f64) -> bool {
-    !(c.force[0].is_finite() && c.force[1].is_finite())
-        || overlap_ratio(particles, pair, c) > max_overlap
+    if !(c.force[0].is_finite() && c.force[1].is_finite()) {
+        return true;
+    }
+    // Most contacts are far below the limit: a multiplication (with room for rounding)
+    // tells, and only those near it take the division that decides.
+    let rmin = smaller_radius(particles, pair);
+    c.overlap > 0.999 * max_overlap * rmin && c.overlap / rmin > max_overlap
+}
+
+/// The smaller radius of a pair (a wall: the particle's).
+#[inline(always)]
+fn smaller_radius(particles: &Particles, pair: Pair) -> f64 {
+    let ri = particles.radius[pair.i as usize];
+    if pair.is_wall() {
+        ri
+    } else {
+        ri.min(particles.radius[pair.j as usize])
+    }
 }
 
 /// A contact's overlap relative to the smaller radius.
 pub fn overlap_ratio(particles: &Particles, pair: Pair, c: &ContactForce) -> f64 {
-    let ri = particles.radius[pair.i as usize];
-    let rmin = if pair.is_wall() {
-        ri
-    } else {
-        ri.min(particles.radius[pair.j as usize])
-    };
-    c.overlap / rmin
+    c.overlap / smaller_radius(particles, pair)
 }
 
-/// Stage: every candidate of the neighbour list evaluated on its own, in parallel: its
-/// contact force or None, and its updated history (0 for a candidate not in contact).
-/// The loop is specialised to the law. Returns the first candidate whose contact
-/// diverges (`diverges`), if any.
+/// What the force reduction needs of one candidate: whether it touches, its force on i
+/// and its two torques (`ContactForce::torque`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Kick {
+    pub force: [f64; 2],
+    pub torque: [f64; 2],
+    pub contact: bool,
+}
+
+/// This step's results of the candidates: for each, its kick and its updated history
+/// (0 when not in contact), and when recording, the whole contact (for outputs).
+#[derive(Clone, Debug, Default)]
+pub struct CandidateResults {
+    pub kicks: Vec<Kick>,
+    pub history: Vec<f64>,
+    /// Every candidate's contact, or None; empty when the step did not record.
+    pub contacts: Vec<Option<ContactForce>>,
+    /// The first candidate whose contact diverges (`diverges`), with that contact.
+    pub diverging: Option<(usize, ContactForce)>,
+}
+
+/// Stage: every candidate of the neighbour list evaluated on its own, in parallel, into
+/// `out`. The loop is specialised to the law. `record`: keep every whole contact too.
 pub fn candidate_forces(
     s: &StepState,
     law: &ContactLaw,
     list: &NeighbourList,
     max_overlap: f64,
-    out: &mut Vec<Option<ContactForce>>,
-    history_out: &mut Vec<f64>,
-) -> Option<usize> {
-    let n = list.pairs.len();
-    out.resize(n, None);
-    history_out.resize(n, 0.0);
-    let f = (out, history_out);
+    record: bool,
+    out: &mut CandidateResults,
+) {
     match law {
-        ContactLaw::SpringDashpot(l) => candidates_with(s, l, list, max_overlap, f.0, f.1),
-        ContactLaw::OverlapArea(l) => candidates_with(s, l, list, max_overlap, f.0, f.1),
-        ContactLaw::Continuous(l) => candidates_with(s, l, list, max_overlap, f.0, f.1),
+        ContactLaw::SpringDashpot(l) => candidates_with(s, l, list, max_overlap, record, out),
+        ContactLaw::OverlapArea(l) => candidates_with(s, l, list, max_overlap, record, out),
+        ContactLaw::Continuous(l) => candidates_with(s, l, list, max_overlap, record, out),
     }
 }
 
@@ -217,26 +243,58 @@ fn candidates_with<L: Law>(
     law: &L,
     list: &NeighbourList,
     max_overlap: f64,
-    out: &mut [Option<ContactForce>],
-    history_out: &mut [f64],
-) -> Option<usize> {
+    record: bool,
+    out: &mut CandidateResults,
+) {
+    let n = list.pairs.len();
+    out.kicks.resize(n, Kick::default());
+    out.history.resize(n, 0.0);
+    out.contacts.clear();
     // The first diverging candidate: the smallest index, whichever thread finds it.
     let first = AtomicUsize::new(usize::MAX);
-    crate::parallel::for_each2(out, history_out, |k, c, h| {
+    let evaluate = |k: usize, kick: &mut Kick, h: &mut f64| {
         let pair = list.pairs[k];
         let r = candidate_force(s, law, pair, list.history[k]);
-        (*c, *h) = match r {
-            Some((f, v)) => {
-                if diverges(s.particles, pair, &f, max_overlap) {
+        match r {
+            Some((c, v)) => {
+                if diverges(s.particles, pair, &c, max_overlap) {
                     first.fetch_min(k, Ordering::Relaxed);
                 }
-                (Some(f), v)
+                *kick = Kick {
+                    force: c.force,
+                    torque: c.torque,
+                    contact: true,
+                };
+                *h = v;
+                Some(c)
             }
-            None => (None, 0.0),
-        };
-    });
+            None => {
+                kick.contact = false;
+                *h = 0.0;
+                None
+            }
+        }
+    };
+    if record {
+        out.contacts.resize(n, None);
+        let mut kh: Vec<(Kick, f64)> = vec![(Kick::default(), 0.0); n];
+        crate::parallel::for_each2(&mut out.contacts, &mut kh, |k, c, (kick, h)| {
+            *c = evaluate(k, kick, h);
+        });
+        for (k, (kick, h)) in kh.into_iter().enumerate() {
+            out.kicks[k] = kick;
+            out.history[k] = h;
+        }
+    } else {
+        crate::parallel::for_each2(&mut out.kicks, &mut out.history, |k, kick, h| {
+            evaluate(k, kick, h);
+        });
+    }
     let k = first.into_inner();
-    (k != usize::MAX).then_some(k)
+    out.diverging = (k != usize::MAX).then(|| {
+        let c = candidate_force(s, law, list.pairs[k], list.history[k]);
+        (k, c.expect("a diverging candidate is a contact").0)
+    });
 }
 
 /// r_i − r_j: the offset of the pair, the only way positions enter a contact's geometry
@@ -430,7 +488,7 @@ fn area_kinematics(
 pub fn reduce_candidate_forces(
     particles: &Particles,
     list: &NeighbourList,
-    contacts: &[Option<ContactForce>],
+    kicks: &[Kick],
     out: &mut Vec<Dof>,
 ) {
     out.clear();
@@ -438,14 +496,15 @@ pub fn reduce_candidate_forces(
     crate::parallel::for_each(out, |p, acc| {
         let down = &list.down[list.down_start[p] as usize..list.down_start[p + 1] as usize];
         for &k in down {
-            if let Some(c) = &contacts[k as usize] {
+            let c = &kicks[k as usize];
+            if c.contact {
                 acc[0] -= c.force[0];
                 acc[1] -= c.force[1];
                 acc[2] -= c.torque[1];
             }
         }
-        let own = &contacts[list.start[p] as usize..list.start[p + 1] as usize];
-        for c in own.iter().flatten() {
+        let own = &kicks[list.start[p] as usize..list.start[p + 1] as usize];
+        for c in own.iter().filter(|c| c.contact) {
             acc[0] += c.force[0];
             acc[1] += c.force[1];
             acc[2] += c.torque[0];

@@ -4,7 +4,9 @@
 //! The step is a sequence of stages (see ARCHITECTURE.md): predict → cell list
 //! (`cell_index`, `cell_histogram`, `prefix_sum`, `scatter`) → `find_contacts` →
 //! `gather_history` → `contact_forces` → `store_history` → `reduce_forces` → correct →
-//! boundaries. Scenes are JSON files (`scene`), runs are driven by `run`.
+//! boundaries on the GPU; the CPU path finds the same contacts among the candidates of
+//! its neighbour lists (`neighbours`) and runs on every core (`parallel`). Scenes are
+//! JSON files (`scene`), runs are driven by `run`.
 
 pub mod analyze;
 pub mod bench;

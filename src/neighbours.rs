@@ -69,7 +69,7 @@ impl NeighbourList {
         (0..particles.len()).any(|i| {
             let (a, b) = (particles.q[0][i], self.at[i]);
             let moved = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
-            particles.active[i] != self.active[i] || !(moved <= limit)
+            particles.active[i] != self.active[i] || moved.is_nan() || moved > limit
         })
     }
 

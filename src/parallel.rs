@@ -6,15 +6,15 @@
 //! it, and no stage sums across items in parallel (the force reduction sums each
 //! particle's contacts on one thread, in a fixed order), so results are bitwise the same
 //! for any thread count. Small stages stay on the calling thread: waking the pool costs
-//! more than a few thousand items.
+//! more than a thousand items.
 
 use rayon::prelude::*;
 
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Below this many items a stage runs on the calling thread (4096 unless a test lowers
+/// Below this many items a stage runs on the calling thread (1024 unless a test lowers
 /// it to run small scenes on every thread).
-static MIN_PARALLEL: AtomicUsize = AtomicUsize::new(4096);
+static MIN_PARALLEL: AtomicUsize = AtomicUsize::new(1024);
 /// Items per task: at most 512, fewer for a small stage so that every thread gets some.
 fn chunk(n: usize) -> usize {
     (n / (8 * rayon::current_num_threads())).clamp(1, 512)

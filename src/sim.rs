@@ -6,7 +6,8 @@ use crate::cell_list::Grid;
 use crate::contacts::Pair;
 use crate::create::{self, source::SourceState};
 use crate::forces::{
-    ContactForce, StepState, candidate_forces, overlap_ratio, reduce_candidate_forces, velocities,
+    CandidateResults, ContactForce, StepState, candidate_forces, overlap_ratio,
+    reduce_candidate_forces, velocities,
 };
 use crate::geometry::WallSegment;
 use crate::integrate::{gear, leapfrog};
@@ -84,8 +85,7 @@ pub struct Simulation {
     /// The candidate pairs and their springs (issue 13), and this evaluation's result of
     /// each candidate.
     pub neighbours: NeighbourList,
-    candidates: Vec<Option<ContactForce>>,
-    candidate_history: Vec<f64>,
+    candidates: CandidateResults,
     /// Whether a step lists its contacts in `pairs` and `contacts` (default; a run
     /// turns it off for the steps between its outputs).
     pub record_contacts: bool,
@@ -93,8 +93,6 @@ pub struct Simulation {
     velocity: Vec<Dof>,
     /// Whether a step has moved the springs into the neighbour list.
     committed: bool,
-    /// The first candidate whose contact diverges at the last evaluation.
-    diverging: Option<usize>,
 }
 
 impl Simulation {
@@ -158,12 +156,10 @@ impl Simulation {
             contacts: Vec::new(),
             forces: Vec::new(),
             neighbours: NeighbourList::default(),
-            candidates: Vec::new(),
-            candidate_history: Vec::new(),
+            candidates: CandidateResults::default(),
             record_contacts: true,
             velocity: Vec::new(),
             committed: false,
-            diverging: None,
         })
     }
 
@@ -239,20 +235,20 @@ impl Simulation {
             walls: &self.walls,
             dt: self.scene.dt,
         };
-        self.diverging = candidate_forces(
+        candidate_forces(
             &state,
             &self.law,
             &self.neighbours,
             self.scene.limits.max_overlap,
+            self.record_contacts,
             &mut self.candidates,
-            &mut self.candidate_history,
         );
         // The contacts, in list order (by i, then j): what find_contacts lists. Only
         // when someone will look (outputs between the steps of a run need none).
         self.pairs.clear();
         self.contacts.clear();
         if self.record_contacts {
-            let listed = self.neighbours.pairs.iter().zip(&self.candidates);
+            let listed = self.neighbours.pairs.iter().zip(&self.candidates.contacts);
             for (p, c) in listed.filter_map(|(p, c)| c.as_ref().map(|c| (p, c))) {
                 self.pairs.push(*p);
                 self.contacts.push(*c);
@@ -266,7 +262,7 @@ impl Simulation {
         if !self.committed {
             return self.springs.clone();
         }
-        let in_contact: Vec<bool> = self.candidates.iter().map(Option::is_some).collect();
+        let in_contact: Vec<bool> = self.candidates.kicks.iter().map(|k| k.contact).collect();
         self.neighbours.table(&in_contact)
     }
 
@@ -282,7 +278,7 @@ impl Simulation {
         reduce_candidate_forces(
             &self.particles,
             &self.neighbours,
-            &self.candidates,
+            &self.candidates.kicks,
             &mut self.forces,
         );
         let g = self.gravity(0.0);
@@ -316,12 +312,12 @@ impl Simulation {
         self.evaluate_contacts();
         self.check_divergence()?;
         // The candidates' updated springs become the list's.
-        std::mem::swap(&mut self.neighbours.history, &mut self.candidate_history);
+        std::mem::swap(&mut self.neighbours.history, &mut self.candidates.history);
         self.committed = true;
         reduce_candidate_forces(
             &self.particles,
             &self.neighbours,
-            &self.candidates,
+            &self.candidates.kicks,
             &mut self.forces,
         );
         if gear {
@@ -379,11 +375,8 @@ impl Simulation {
 
     fn check_divergence(&self) -> Result<(), Divergence> {
         let limit = self.scene.limits.max_overlap;
-        if let Some(k) = self.diverging {
-            let pair = self.neighbours.pairs[k];
-            let c = self.candidates[k]
-                .as_ref()
-                .expect("a diverging candidate is a contact");
+        if let Some((k, c)) = &self.candidates.diverging {
+            let pair = self.neighbours.pairs[*k];
             if !(c.force[0].is_finite() && c.force[1].is_finite()) {
                 return Err(Divergence::NotFinite {
                     id: pair.i,
