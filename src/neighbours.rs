@@ -66,11 +66,12 @@ impl NeighbourList {
             return true;
         }
         let limit = 0.25 * self.skin * self.skin;
-        (0..particles.len()).any(|i| {
+        let moved = |i: usize| {
             let (a, b) = (particles.q[0][i], self.at[i]);
-            let moved = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
-            particles.active[i] != self.active[i] || moved.is_nan() || moved > limit
-        })
+            let d2 = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+            particles.active[i] != self.active[i] || d2.is_nan() || d2 > limit
+        };
+        crate::parallel::position_first(particles.len(), moved).is_some()
     }
 
     /// Lists the candidates of the current state and carries the history over: from
@@ -153,14 +154,17 @@ fn cell_key(grid: &Grid, x: u32, z: u32) -> u64 {
 
 /// Every active particle as (cell key, id), sorted: by cell, and by id within a cell.
 fn sort_by_cell(grid: &Grid, particles: &Particles, out: &mut Vec<(u64, u32)>) {
+    let q = &particles.q[0];
     out.clear();
-    for (i, p) in particles.q[0].iter().enumerate() {
-        if particles.active[i] {
-            let (x, z) = grid.cell_coords([p[0], p[1]]);
-            out.push((cell_key(grid, x, z), i as u32));
-        }
-    }
-    out.sort_unstable();
+    out.extend(
+        crate::parallel::map(particles.len(), |i| {
+            let (x, z) = grid.cell_coords([q[i][0], q[i][1]]);
+            (cell_key(grid, x, z), i as u32)
+        })
+        .into_iter()
+        .filter(|&(_, i)| particles.active[i as usize]),
+    );
+    crate::parallel::sort_unstable(out);
 }
 
 /// The particles of the cells x0..=x1 of row z: one run of the sorted list.
@@ -178,7 +182,7 @@ fn row_of_cells<'a>(
 }
 
 /// The candidates of every active particle, in contact order, and where each particle's
-/// start. A pair of two fixed particles is never a candidate (neither moves).
+/// start (each particle's found on its own, on every thread).
 #[allow(clippy::too_many_arguments)]
 fn list_candidates(
     grid: &Grid,
@@ -190,48 +194,67 @@ fn list_candidates(
     out: &mut Vec<Pair>,
     start: &mut Vec<u32>,
 ) {
-    let pos = &particles.q[0];
-    for i in 0..particles.len() {
+    let lists = crate::parallel::map(particles.len(), |i| {
+        let mut v = Vec::new();
+        candidates_of(grid, cells, particles, walls, range_factor, skin, i, &mut v);
+        v
+    });
+    for v in lists {
         start.push(out.len() as u32);
-        if !particles.active[i] {
-            continue;
-        }
-        let pi = [pos[i][0], pos[i][1]];
-        let (cx, cz) = grid.cell_coords(pi);
-        let first = out.len();
-        let (x0, x1) = (cx.saturating_sub(1), (cx + 1).min(grid.nx - 1));
-        for z in cz.saturating_sub(1)..=(cz + 1).min(grid.nz - 1) {
-            {
-                // The three cells x0..=x1 of a row are one run of the sorted list.
-                for &(_, j) in row_of_cells(grid, cells, x0, x1, z) {
-                    let ju = j as usize;
-                    if ju <= i || (particles.fixed[i] && particles.fixed[ju]) {
-                        continue;
-                    }
-                    let (dx, dz) = (pos[ju][0] - pi[0], pos[ju][1] - pi[1]);
-                    let reach = range_factor * (particles.radius[i] + particles.radius[ju]) + skin;
-                    // A NaN distance (a diverged state) is no candidate.
-                    if dx * dx + dz * dz < reach * reach {
-                        out.push(Pair { i: i as u32, j });
-                    }
-                }
+        out.extend(v);
+    }
+    start.push(out.len() as u32);
+}
+
+/// Particle i's candidates in contact order: partners j > i within range + skin by
+/// increasing j, then the walls. A pair of two fixed particles is never a candidate
+/// (neither moves); an inactive particle has none.
+#[allow(clippy::too_many_arguments)]
+fn candidates_of(
+    grid: &Grid,
+    cells: &[(u64, u32)],
+    particles: &Particles,
+    walls: &[WallSegment],
+    range_factor: f64,
+    skin: f64,
+    i: usize,
+    out: &mut Vec<Pair>,
+) {
+    if !particles.active[i] {
+        return;
+    }
+    let pos = &particles.q[0];
+    let pi = [pos[i][0], pos[i][1]];
+    let (cx, cz) = grid.cell_coords(pi);
+    let (x0, x1) = (cx.saturating_sub(1), (cx + 1).min(grid.nx - 1));
+    for z in cz.saturating_sub(1)..=(cz + 1).min(grid.nz - 1) {
+        // The three cells x0..=x1 of a row are one run of the sorted list.
+        for &(_, j) in row_of_cells(grid, cells, x0, x1, z) {
+            let ju = j as usize;
+            if ju <= i || (particles.fixed[i] && particles.fixed[ju]) {
+                continue;
             }
-        }
-        out[first..].sort_unstable();
-        if particles.fixed[i] {
-            continue;
-        }
-        for (w, wall) in walls.iter().enumerate() {
-            let g = disk_wall(particles.radius[i], &wall_from(wall, pi));
-            if 0.5 * g.r < range_factor * particles.radius[i] + skin {
-                out.push(Pair {
-                    i: i as u32,
-                    j: WALL_BASE + w as u32,
-                });
+            let (dx, dz) = (pos[ju][0] - pi[0], pos[ju][1] - pi[1]);
+            let reach = range_factor * (particles.radius[i] + particles.radius[ju]) + skin;
+            // A NaN distance (a diverged state) is no candidate.
+            if dx * dx + dz * dz < reach * reach {
+                out.push(Pair { i: i as u32, j });
             }
         }
     }
-    start.push(out.len() as u32);
+    out.sort_unstable();
+    if particles.fixed[i] {
+        return;
+    }
+    for (w, wall) in walls.iter().enumerate() {
+        let g = disk_wall(particles.radius[i], &wall_from(wall, pi));
+        if 0.5 * g.r < range_factor * particles.radius[i] + skin {
+            out.push(Pair {
+                i: i as u32,
+                j: WALL_BASE + w as u32,
+            });
+        }
+    }
 }
 
 /// Each new candidate's history from the old list: both are sorted by pair, so one

@@ -116,3 +116,29 @@ where
         (0..n).position(f)
     }
 }
+
+/// [f(0), …, f(n − 1)], in order.
+pub fn map<T, F>(n: usize, f: F) -> Vec<T>
+where
+    T: Send,
+    F: Fn(usize) -> T + Sync + Send,
+{
+    if parallel(n) {
+        (0..n)
+            .into_par_iter()
+            .with_min_len(chunk(n))
+            .map(f)
+            .collect()
+    } else {
+        (0..n).map(f).collect()
+    }
+}
+
+/// Sorts v (unstable: for keys that are all different, the order is the same either way).
+pub fn sort_unstable<T: Ord + Send>(v: &mut [T]) {
+    if parallel(v.len()) {
+        v.par_sort_unstable();
+    } else {
+        v.sort_unstable();
+    }
+}
