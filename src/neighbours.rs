@@ -62,16 +62,24 @@ impl NeighbourList {
     /// Whether the list must be rebuilt before evaluating `particles`: never built, a
     /// particle inserted or removed, or one moved by more than skin/2 since the rebuild.
     pub fn needs_rebuild(&self, particles: &Particles) -> bool {
-        if !self.is_built() || self.skin <= 0.0 || particles.len() != self.at.len() {
-            return true;
-        }
-        let limit = 0.25 * self.skin * self.skin;
-        let moved = |i: usize| {
-            let (a, b) = (particles.q[0][i], self.at[i]);
-            let d2 = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
-            particles.active[i] != self.active[i] || d2.is_nan() || d2 > limit
-        };
-        crate::parallel::position_first(particles.len(), moved).is_some()
+        self.stale(particles)
+            || crate::parallel::position_first(particles.len(), |i| self.moved(particles, i))
+                .is_some()
+    }
+
+    /// Whether the list must be rebuilt whatever the particles' motion: never built, no
+    /// skin, or particles inserted since.
+    pub fn stale(&self, particles: &Particles) -> bool {
+        !self.is_built() || self.skin <= 0.0 || particles.len() != self.at.len()
+    }
+
+    /// Whether particle i (of a list that is not `stale`) was removed, or moved by more
+    /// than skin/2, since the rebuild. A position that is not finite has "moved".
+    #[inline]
+    pub fn moved(&self, particles: &Particles, i: usize) -> bool {
+        let (a, b) = (particles.q[0][i], self.at[i]);
+        let d2 = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+        particles.active[i] != self.active[i] || d2.is_nan() || d2 > 0.25 * self.skin * self.skin
     }
 
     /// Lists the candidates of the current state and carries the history over: from

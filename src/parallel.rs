@@ -69,6 +69,29 @@ where
     }
 }
 
+/// f(k0, &mut a[k0..k0 + m], &mut b[k0..k0 + m]) for consecutive blocks of m ≤ `block`
+/// items (a and b of equal length): for loops that treat a few items stage by stage.
+pub fn for_each_block2<A, B, F>(a: &mut [A], b: &mut [B], block: usize, f: F)
+where
+    A: Send,
+    B: Send,
+    F: Fn(usize, &mut [A], &mut [B]) + Sync + Send,
+{
+    assert_eq!(a.len(), b.len());
+    if parallel(a.len()) {
+        let c = chunk(a.len()).div_ceil(block);
+        a.par_chunks_mut(block)
+            .zip(b.par_chunks_mut(block))
+            .enumerate()
+            .with_min_len(c)
+            .for_each(|(m, (x, y))| f(m * block, x, y));
+    } else {
+        for (m, (x, y)) in a.chunks_mut(block).zip(b.chunks_mut(block)).enumerate() {
+            f(m * block, x, y);
+        }
+    }
+}
+
 /// f(k, [&mut v0[k], …, &mut v5[k]]) for every k: the six Gear values of a particle.
 pub fn for_each6<T, F>(v: &mut [Vec<T>; 6], f: F)
 where
@@ -108,10 +131,13 @@ where
     F: Fn(usize) -> bool + Sync + Send,
 {
     if parallel(n) {
-        (0..n)
+        // Each task scans its block on its own and the smallest hit wins: rayon's
+        // position_first would synchronise on every item.
+        let c = chunk(n);
+        (0..n.div_ceil(c))
             .into_par_iter()
-            .with_min_len(chunk(n))
-            .position_first(f)
+            .filter_map(|b| (b * c..n.min((b + 1) * c)).find(|&k| f(k)))
+            .min()
     } else {
         (0..n).position(f)
     }

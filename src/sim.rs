@@ -7,7 +7,7 @@ use crate::contacts::Pair;
 use crate::create::{self, source::SourceState};
 use crate::forces::{
     CandidateResults, ContactForce, StepState, candidate_forces, overlap_ratio,
-    reduce_candidate_forces, velocities,
+    kick_sum, reduce_candidate_forces,
 };
 use crate::geometry::WallSegment;
 use crate::integrate::{gear, leapfrog};
@@ -18,6 +18,7 @@ use crate::scene::{Creation, IntegratorKind, Scene, SceneError};
 use crate::shape::{RotatedCorners, rotate_corners};
 use crate::springs::SpringTable;
 use crate::state::{Dof, Particles};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// Why a step could not be completed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -91,6 +92,8 @@ pub struct Simulation {
     pub record_contacts: bool,
     /// Every particle's velocity q1/dt at the evaluated state.
     velocity: Vec<Dof>,
+    /// The first active particle whose position at the evaluated state is not finite.
+    lost_position: Option<usize>,
     /// Whether a step has moved the springs into the neighbour list.
     committed: bool,
 }
@@ -159,6 +162,7 @@ impl Simulation {
             candidates: CandidateResults::default(),
             record_contacts: true,
             velocity: Vec::new(),
+            lost_position: None,
             committed: false,
         })
     }
@@ -208,13 +212,37 @@ impl Simulation {
         crate::scene::max_diameter(&self.scene).max(2.0 * self.particles.max_radius())
     }
 
+    /// Stage: one pass over the particles at the state about to be evaluated: each
+    /// one's velocity q1/dt (what every contact reads), whether one has moved beyond the
+    /// neighbour list's skin (returned), and the first whose position is not finite.
+    fn survey(&mut self) -> bool {
+        let (p, list, dt) = (&self.particles, &self.neighbours, self.scene.dt);
+        let check_moves = !list.stale(p);
+        let moved = AtomicBool::new(false);
+        let lost = AtomicUsize::new(usize::MAX);
+        self.velocity.resize(p.len(), [0.0; 3]);
+        crate::parallel::for_each(&mut self.velocity, |i, v| {
+            *v = p.velocity(i, dt);
+            if check_moves && list.moved(p, i) {
+                moved.store(true, Ordering::Relaxed);
+            }
+            if p.active[i] && !p.q[0][i].iter().all(|v| v.is_finite()) {
+                lost.fetch_min(i, Ordering::Relaxed);
+            }
+        });
+        let lost = lost.into_inner();
+        self.lost_position = (lost != usize::MAX).then_some(lost);
+        moved.into_inner()
+    }
+
     /// Stages 2–8 at the current (predicted) state: the neighbour list (rebuilt when a
     /// particle has moved by half the skin, or was inserted or removed), rotated
     /// corners, and every candidate's contact and force from its spring of the last
     /// step. Public for measurements and tests of the contacts of a given state; it does
     /// not advance and keeps the springs as they were.
     pub fn evaluate_contacts(&mut self) {
-        if self.neighbours.needs_rebuild(&self.particles) {
+        let moved = self.survey();
+        if moved || self.neighbours.stale(&self.particles) {
             let d = &self.scene.domain;
             self.neighbours.rebuild(
                 (d.x, d.z),
@@ -227,7 +255,6 @@ impl Simulation {
             );
         }
         rotate_corners(&self.particles, &mut self.corners);
-        velocities(&self.particles, self.scene.dt, &mut self.velocity);
         let state = StepState {
             particles: &self.particles,
             velocity: &self.velocity,
@@ -314,19 +341,16 @@ impl Simulation {
         // The candidates' updated springs become the list's.
         std::mem::swap(&mut self.neighbours.history, &mut self.candidates.history);
         self.committed = true;
-        reduce_candidate_forces(
-            &self.particles,
-            &self.neighbours,
-            &self.candidates.kicks,
-            &mut self.forces,
-        );
+        // Each particle's force is summed from its candidates' kicks where it is used.
+        let (list, kicks) = (&self.neighbours, &self.candidates.kicks);
+        let force = |i: usize| kick_sum(list, kicks, i);
         if gear {
             // Forces were evaluated at the predicted state, i.e. at time t + dt.
             let g = self.gravity(t + dt);
-            gear::correct(&mut self.particles, &self.forces, g, dt);
+            gear::correct(&mut self.particles, force, g, dt);
         } else {
             let g = self.gravity(t);
-            leapfrog::kick_drift(&mut self.particles, &self.forces, g, dt);
+            leapfrog::kick_drift(&mut self.particles, force, g, dt);
         }
         self.remove_escaped();
         self.step += 1;
@@ -395,9 +419,7 @@ impl Simulation {
                 limit,
             });
         }
-        let p = &self.particles;
-        let lost = |i: usize| p.active[i] && !p.q[0][i].iter().all(|v| v.is_finite());
-        if let Some(i) = crate::parallel::position_first(p.len(), lost) {
+        if let Some(i) = self.lost_position {
             return Err(Divergence::NotFinite {
                 id: i as u32,
                 what: "position",

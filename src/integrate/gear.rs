@@ -65,12 +65,16 @@ pub fn predict(p: &mut Particles) {
     });
 }
 
-/// Stage: correct every integrated particle with its force at the predicted state.
-pub fn correct(p: &mut Particles, forces: &[Dof], gravity: [f64; 2], dt: f64) {
+/// Stage: correct every integrated particle with its force at the predicted state,
+/// `force(i)` (fx, fz, τ).
+pub fn correct<F>(p: &mut Particles, force: F, gravity: [f64; 2], dt: f64)
+where
+    F: Fn(usize) -> Dof + Sync + Send,
+{
     let (q, active, fixed, mass, inertia) = (&mut p.q, &p.active, &p.fixed, &p.mass, &p.inertia);
     crate::parallel::for_each6(q, |i, v| {
         if active[i] && !fixed[i] {
-            let a = super::acceleration(forces[i], mass[i], inertia[i], gravity);
+            let a = super::acceleration(force(i), mass[i], inertia[i], gravity);
             let mut q = [*v[0], *v[1], *v[2], *v[3], *v[4], *v[5]];
             correct_one(&mut q, a, dt, &CORRECTOR);
             for (dst, src) in v.into_iter().zip(q) {

@@ -18,12 +18,16 @@ pub fn kick_drift_one(q0: &mut Dof, q1: &mut Dof, accel: Dof, dt: f64) {
 
 /// Stage: advance every integrated particle with the force at the current positions
 /// (each on its own, on every thread).
-pub fn kick_drift(p: &mut Particles, forces: &[Dof], gravity: [f64; 2], dt: f64) {
+/// `force(i)`: the force and torque (fx, fz, τ) on particle i.
+pub fn kick_drift<F>(p: &mut Particles, force: F, gravity: [f64; 2], dt: f64)
+where
+    F: Fn(usize) -> Dof + Sync + Send,
+{
     let (active, fixed, mass, inertia) = (&p.active, &p.fixed, &p.mass, &p.inertia);
     let [q0, q1, ..] = &mut p.q;
     crate::parallel::for_each2(q0, q1, |i, q0, q1| {
         if active[i] && !fixed[i] {
-            let a = acceleration(forces[i], mass[i], inertia[i], gravity);
+            let a = acceleration(force(i), mass[i], inertia[i], gravity);
             kick_drift_one(q0, q1, a, dt);
         }
     });
