@@ -128,11 +128,23 @@ fn norm(a: P2) -> f64 {
 fn clip_lines(src: &Clip, a: P2, m: P2, id: u32, dst: &mut Clip) {
     dst.n = 0;
     let n = src.n;
+    if n == 0 {
+        return;
+    }
+    let side = |x: P2| dot(sub(x, a), m);
     // Edge e runs from corner e to the next, the last back to the first (no modulo: an
-    // integer division for every corner of every clip cost more than the clip).
+    // integer division for every corner of every clip cost more than the clip). Each
+    // corner's side is computed once and carried to the next edge (the kernel computes
+    // it twice; the values are the same).
+    let first = side(src.v[0]);
+    let mut dx = first;
     for e in 0..n {
-        let (x, y) = (src.v[e], src.v[if e + 1 == n { 0 } else { e + 1 }]);
-        let (dx, dy) = (dot(sub(x, a), m), dot(sub(y, a), m));
+        let x = src.v[e];
+        let (y, dy) = if e + 1 == n {
+            (src.v[0], first)
+        } else {
+            (src.v[e + 1], side(src.v[e + 1]))
+        };
         if dx >= 0.0 {
             dst.push(x, src.line[e]);
         }
@@ -141,6 +153,7 @@ fn clip_lines(src: &Clip, a: P2, m: P2, id: u32, dst: &mut Clip) {
             let at = [x[0] + t * (y[0] - x[0]), x[1] + t * (y[1] - x[1])];
             dst.push(at, if dx >= 0.0 { id } else { src.line[e] });
         }
+        dx = dy;
     }
 }
 
@@ -188,14 +201,14 @@ fn clip_by(p: &[P2], q: &[P2], buf: &mut [Clip; 3]) -> usize {
     for k in 0..nq {
         let (a, b) = (q[k], q[if k + 1 == nq { 0 } else { k + 1 }]);
         let m = [-(b[1] - a[1]), b[0] - a[0]];
-        let reach = r * norm(m);
         let centre = -dot(a, m);
-        if centre >= reach {
-            continue;
-        }
-        if centre <= -reach {
-            buf[cur].n = 0;
-            break;
+        match circle_side(centre, r, m) {
+            Side::Inside => continue,
+            Side::Outside => {
+                buf[cur].n = 0;
+                break;
+            }
+            Side::Across => {}
         }
         let [x, y, _] = buf;
         let (src, dst) = if cur == 0 { (&*x, y) } else { (&*y, x) };
@@ -206,6 +219,50 @@ fn clip_by(p: &[P2], q: &[P2], buf: &mut [Clip; 3]) -> usize {
         }
     }
     cur
+}
+
+/// Where the circle of radius r about the origin lies with respect to the line
+/// {x : (x − a)·m = 0}, given `centre` = −a·m (the origin's side, times |m|).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Side {
+    Inside,
+    Outside,
+    Across,
+}
+
+/// The test is centre ≥ r|m| (inside), centre ≤ −r|m| (outside). Its square root is
+/// taken only where squares cannot tell: far from the boundary the squares decide with
+/// room for their rounding (1e-9), and near it the same rounded r|m| as always decides,
+/// so the decision never changes with the shortcut.
+#[inline]
+fn circle_side(centre: f64, r: f64, m: P2) -> Side {
+    let (c2, r2) = (centre * centre, r * r * dot(m, m));
+    // (Squares of lengths below 1e-140 lose bits to underflow: no shortcut there.)
+    if !(r2 > 1e-280) {
+        return circle_side_exact(centre, r, m);
+    }
+    if c2 < r2 * (1.0 - 1e-9) {
+        return Side::Across;
+    }
+    if c2 > r2 * (1.0 + 1e-9) {
+        return if centre > 0.0 {
+            Side::Inside
+        } else {
+            Side::Outside
+        };
+    }
+    circle_side_exact(centre, r, m)
+}
+
+fn circle_side_exact(centre: f64, r: f64, m: P2) -> Side {
+    let reach = r * norm(m);
+    if centre >= reach {
+        Side::Inside
+    } else if centre <= -reach {
+        Side::Outside
+    } else {
+        Side::Across
+    }
 }
 
 /// The overlap area of polygons p (corners relative to r_i) and q (relative to r_j),
