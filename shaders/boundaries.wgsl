@@ -13,10 +13,17 @@ fn boundaries(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (p.x < params.dom_lo_x || p.x > params.dom_hi_x || p.y < params.dom_lo_z || p.y > params.dom_hi_z) {
         props[i].flags &= ~ACTIVE;
         atomicAdd(&control[C_LOST], 1u);
+        // Its candidates leave the lists at the next step (as on the CPU path).
+        request_rebuild();
     }
 }
 
 @compute @workgroup_size(1)
 fn advance_clock() {
-    if (!halted()) { atomicAdd(&control[C_STEP], 1u); }
+    if (!halted()) {
+        atomicAdd(&control[C_STEP], 1u);
+        // The lists are current; what the next step needs is asked for again.
+        if (rebuilding()) { atomicAdd(&control[C_REBUILDS], 1u); }
+        atomicStore(&control[C_LISTS], 0u);
+    }
 }

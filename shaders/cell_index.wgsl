@@ -1,10 +1,12 @@
 // Stage 1 of the counting sort (src/cell_list.rs `cell_index`): the cell of each active
 // particle. The anchor *is* the cell, clamped into the grid. Also clears the per-step
-// counters of the later stages.
+// counters of the later stages. Like every stage of the cell list, it runs only when
+// the neighbour lists are rebuilt (issue 13).
 
 @compute @workgroup_size(WG)
 fn clear_cells(@builtin(global_invocation_id) gid: vec3<u32>) {
     let c = gid.x;
+    if (!rebuilding()) { return; }
     if (c < params.cells) { atomicStore(&cell_count[c], 0u); }
     if (c < params.n_cap) { atomicStore(&down_count[c], 0u); }
 }
@@ -12,7 +14,7 @@ fn clear_cells(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(WG)
 fn cell_index(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.n_cap) { return; }
+    if (i >= params.n_cap || !rebuilding()) { return; }
     if (i >= live() || !is_active(i)) { cell_of[i] = EMPTY; return; }
     let c = cell_coords(state[i].anchor);
     cell_of[i] = c.y * params.nx + c.x;

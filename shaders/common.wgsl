@@ -24,7 +24,19 @@ const C_LOST: u32 = 2u;
 const C_HALT: u32 = 3u;
 const C_HALT_STEP: u32 = 4u;
 const C_HALT_ID: u32 = 5u;
+// Bits of the neighbour lists' word (src/neighbours.rs; issue 13).
+const C_LISTS: u32 = 6u;
+// How many times the lists were built.
+const C_REBUILDS: u32 = 7u;
 const C_BLOCKED: u32 = 8u;
+// control[C_LISTS]: REBUILD, the lists are rebuilt this step (a particle moved more
+// than skin/2, or was inserted or removed, or the state was uploaded); TABLE_CURRENT,
+// the spring table holds the springs (an upload: the first rebuild takes them from it
+// instead of storing the lists' into it); FLUSH, the host asks for the table of the
+// current lists (`GpuSimulation::device_state`).
+const REBUILD: u32 = 1u;
+const TABLE_CURRENT: u32 = 2u;
+const FLUSH: u32 = 4u;
 // Halt reasons (bits of control[C_HALT]).
 const HALT_OVERLAP: u32 = 1u;
 const HALT_NOT_FINITE: u32 = 2u;
@@ -80,7 +92,8 @@ struct Params {
     // fixed-point positions (position.wgsl): unit = cell_size / 2^30, and its inverse
     unit: f32,
     inv_unit: f32,
-    _pad: u32,
+    // the neighbour lists' skin (length units)
+    skin: f32,
 };
 
 // Dynamic state: q[0] = (rem_x, rem_z, rem_theta, 0) with the position's remainder in
@@ -91,7 +104,10 @@ struct State {
     anchor: vec2<i32>,
     frac: vec2<u32>,
     turn: u32,
-    _pad: array<u32, 3>,
+    // Where the particle was when the lists were built: its anchor (two i16 in one word)
+    // and frac (src/neighbours.rs `moved`; the survey kernel).
+    listed_anchor: u32,
+    listed_frac: vec2<u32>,
 };
 
 struct Props {
@@ -173,7 +189,8 @@ struct Candidate {
 @group(0) @binding(10) var<storage, read_write> down: array<u32>;
 @group(0) @binding(11) var<storage, read_write> down_count: array<atomic<u32>>;
 @group(0) @binding(12) var<storage, read_write> hist_in: array<f32>;
-@group(0) @binding(13) var<storage, read_write> hist_out: array<f32>;
+// Whether each candidate of the lists touched at the last evaluation (1) or not (0).
+@group(0) @binding(13) var<storage, read_write> touching: array<u32>;
 @group(0) @binding(14) var<storage, read_write> contact_out: array<ContactOut>;
 @group(0) @binding(15) var<storage, read_write> force: array<vec4<f32>>;
 @group(0) @binding(16) var<storage, read_write> walls: array<Wall>;
@@ -183,10 +200,9 @@ struct Candidate {
 // Polygon corners in whole position units (counter-clockwise, centroid at the origin):
 // xy in the body frame, zw rotated to the particle's orientation (orientation.wgsl).
 @group(0) @binding(20) var<storage, read_write> corners: array<vec4<i32>>;
-// The spring table of the previous step (read) and of this step (written); the host
-// swaps the two buffers every step.
-@group(1) @binding(0) var<storage, read_write> table_old: array<Entry>;
-@group(1) @binding(1) var<storage, read_write> table_new: array<Entry>;
+// The spring table keyed by pair: touched only at a rebuild of the lists, which stores
+// the old lists' springs into it and gathers the new lists' from it (issue 13).
+@group(1) @binding(0) var<storage, read_write> table: array<Entry>;
 
 fn is_active(i: u32) -> bool {
     return (props[i].flags & ACTIVE) != 0u;
@@ -202,6 +218,19 @@ fn is_integrated(i: u32) -> bool {
 
 fn halted() -> bool {
     return atomicLoad(&control[C_HALT]) != 0u;
+}
+
+fn lists_word() -> u32 {
+    return atomicLoad(&control[C_LISTS]);
+}
+
+// Whether this step rebuilds the neighbour lists.
+fn rebuilding() -> bool {
+    return (lists_word() & REBUILD) != 0u;
+}
+
+fn request_rebuild() {
+    atomicOr(&control[C_LISTS], REBUILD);
 }
 
 fn live() -> u32 {

@@ -1,6 +1,38 @@
-// Stage (src/forces.rs `contact_forces`): each contact on its own: geometry, relative
-// velocity at the contact point, law. Stores the force on i, both torques, the normal
-// and contact point it used, and the updated history; flags a diverging contact.
+// Stage (src/forces.rs `candidate_forces`): each candidate of the lists on its own:
+// whether it touches (`touches`: the test of src/forces.rs `candidate_force`), and if it
+// does, its geometry, the relative velocity at the contact point and the law. Stores
+// the force on i, both torques, the normal and contact point it used, and the updated
+// history in the candidate's slot; a candidate that does not touch gets zero force and
+// history. Flags a diverging contact.
+
+// Whether disks i and j interact (r < range_factor * sigma). The f32 distance is right
+// to ~1e-7 relative, so only pairs within 1e-5 of the boundary need the exact geometry
+// `g` (disk_disk(i, j), computed by the caller anyway).
+fn disks_touch(i: u32, j: u32, g: Geometry) -> bool {
+    let o = offset_ij(i, j);
+    if (!o.near) { return false; }
+    let v = offset_vector(o);
+    let reach = params.range_factor * (props[i].radius + props[j].radius);
+    let r2 = dot(v, v);
+    let margin = 2.0e-5 * reach * reach;
+    if (r2 > reach * reach + margin) { return false; }
+    if (r2 < reach * reach - margin) { return true; }
+    return g.r < params.range_factor * g.sigma;
+}
+
+// Polygons (and disks under the area law) first by their circumscribed circles, with
+// f32 slack; then they touch when the overlap area `a` is found.
+fn circles_near(i: u32, j: u32) -> bool {
+    let o = offset_ij(i, j);
+    if (!o.near) { return false; }
+    let v = offset_vector(o);
+    let reach = params.range_factor * (props[i].radius + props[j].radius);
+    return dot(v, v) <= reach * reach + 2.0e-5 * reach * reach;
+}
+
+fn wall_circle_near(i: u32, w: u32) -> bool {
+    return disk_wall(i, w).delta >= -1.0e-5 * props[i].radius;
+}
 
 fn velocity(i: u32) -> vec3<f32> {
     return state[i].q[1].xyz / params.dt;
@@ -16,13 +48,13 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
     for (var k = 0u; k < contact_count[i]; k++) {
         let slot = i * MAX_CONTACTS + k;
         let j = contact_j[slot];
+        let wall = j >= WALL_BASE;
         var g: Geometry;
         var v2 = vec3<f32>(0.0);
         var d_ij = vec2<f32>(0.0);   // centre i minus centre j
         var rmin = ri;
         var m12 = m1;
         var mass = m1;
-        let wall = j >= WALL_BASE;
         if (!wall) {
             d_ij = offset_vector(offset_ij(i, j));
             v2 = velocity(j);
@@ -34,9 +66,17 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         // The law sees the rate of delta: the overlap's for disks, L v_n / l for the
         // overlap area (delta = A/l; src/forces.rs `area_contact_input`).
         var rate = 1.0;
+        var touches = false;
         if (POLYGONS) {
             var a: AreaContact;
-            if (wall) { a = area_contact_wall(i, j - WALL_BASE, false); } else { a = area_contact(i, j, false); }
+            if (wall) {
+                touches = wall_circle_near(i, j - WALL_BASE);
+                if (touches) { a = area_contact_wall(i, j - WALL_BASE, false); }
+            } else {
+                touches = circles_near(i, j);
+                if (touches) { a = area_contact(i, j, false); }
+            }
+            touches = touches && a.found;
             var delta = 0.0;
             var depth = 0.0;
             rate = 0.0;
@@ -48,9 +88,18 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
             g = Geometry(a.n, delta, depth, 0.0, a.point, true);
         } else if (wall) {
             g = disk_wall(i, j - WALL_BASE);
+            touches = g.r < params.range_factor * g.sigma;
         } else {
             g = disk_disk(i, j);
+            touches = disks_touch(i, j, g);
         }
+        if (!touches) {
+            contact_out[slot] = ContactOut(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+            hist_in[slot] = 0.0;
+            touching[slot] = 0u;
+            continue;
+        }
+        touching[slot] = 1u;
         let l1 = g.arm;
         let l2 = d_ij + l1;
         let s1 = v1.z * vec2<f32>(-l1.y, l1.x);
@@ -66,7 +115,8 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         contact_out[slot] = ContactOut(vec4<f32>(f, cross2(l1, f), -cross2(l2, f)),
                                        vec4<f32>(res.f_n, res.f_t, g.delta, res.energy),
                                        vec4<f32>(g.n, l1));
-        hist_out[slot] = res.history;
+        // In place: the slot's spring is the list's history from step to step.
+        hist_in[slot] = res.history;
         let finite = abs(f.x) <= 3.0e38 && abs(f.y) <= 3.0e38;
         if (!finite) { halt(HALT_NOT_FINITE, i); }
         if (g.delta / rmin > params.max_overlap) { halt(HALT_OVERLAP, i); }

@@ -1,40 +1,41 @@
-// Stage (src/contacts.rs `find_contacts`): for particle i, every j > i in the 3x3 cells
-// around it within the law's range, sorted by j, then its walls. Each contact is also
-// entered in j's `down` list (slot index i * MAX_CONTACTS + k), which the reduction
-// needs; that list is filled by atomics and sorted where it is read.
+// Stage (src/neighbours.rs `list_candidates`; at a rebuild of the lists only): for
+// particle i, every j > i in the 3x3 cells around it whose circles come within the
+// skin of the law's range, sorted by j, then its walls. Each candidate is also entered
+// in j's `down` list (slot index i * MAX_CONTACTS + k), which the reduction needs; that
+// list is filled by atomics and sorted where it is read. Whether a candidate touches is
+// decided at every step, in contact_forces (`touches`, `touches_wall`).
 
-// Whether disks i and j interact (r < range_factor * sigma). The f32 distance is right
-// to ~1e-7 relative, so only pairs within 1e-5 of the boundary need the exact geometry.
-fn in_range(i: u32, j: u32) -> bool {
+// Whether disks (or the circumscribed circles of) i and j come within range + skin.
+// f32 with room for its rounding: a candidate too many costs nothing.
+fn is_candidate(i: u32, j: u32) -> bool {
     let o = offset_ij(i, j);
     if (!o.near) { return false; }
     let v = offset_vector(o);
-    let reach = params.range_factor * (props[i].radius + props[j].radius);
-    let r2 = dot(v, v);
-    let margin = 2.0e-5 * reach * reach;
-    if (r2 > reach * reach + margin) { return false; }
-    // Polygons: inside the circumscribed circles, a contact is a positive overlap area.
-    if (POLYGONS) { return area_contact(i, j, true).found; }
-    if (r2 < reach * reach - margin) { return true; }
-    let g = disk_disk(i, j);
-    return g.r < params.range_factor * g.sigma;
+    let reach = params.range_factor * (props[i].radius + props[j].radius) + params.skin;
+    return dot(v, v) <= reach * reach * (1.0 + 4.0e-5);
 }
 
-fn touches_wall(i: u32, w: u32) -> bool {
+fn is_wall_candidate(i: u32, w: u32) -> bool {
     let g = disk_wall(i, w);
-    if (POLYGONS) {
-        // The circumscribed circle first (with f32 slack), then the area.
-        if (g.delta < -1.0e-5 * props[i].radius) { return false; }
-        return area_contact_wall(i, w, true).found;
-    }
-    return g.r < params.range_factor * g.sigma;
+    if (!g.near) { return false; }
+    // g.r is twice the distance to the wall (disk_wall's mirror disk).
+    let reach = params.range_factor * props[i].radius + params.skin;
+    return 0.5 * g.r <= reach * (1.0 + 2.0e-5);
+}
+
+// Records where particle i is as its lists are built (for survey's `moved`).
+fn mark_listed(i: u32) {
+    let a = state[i].anchor;
+    state[i].listed_anchor = (u32(a.x) & 0xFFFFu) | (u32(a.y) << 16u);
+    state[i].listed_frac = state[i].frac;
 }
 
 @compute @workgroup_size(WG)
 fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.n_cap) { return; }
+    if (i >= params.n_cap || !rebuilding()) { return; }
     if (i >= live() || halted() || !is_active(i)) { contact_count[i] = 0u; return; }
+    mark_listed(i);
     var found: array<u32, MAX_CONTACTS>;
     var n = 0u;
     let fixed_i = is_fixed(i);
@@ -51,7 +52,7 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
             for (var s = start; s < end; s++) {
                 let j = sorted[s];
                 if (j <= i || (fixed_i && is_fixed(j))) { continue; }
-                if (!in_range(i, j)) { continue; }
+                if (!is_candidate(i, j)) { continue; }
                 if (n == MAX_CONTACTS) { halt(HALT_CONTACTS_FULL, i); break; }
                 // Insertion sort by j: the order must not depend on the cell layout.
                 var k = n;
@@ -63,7 +64,7 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     if (!fixed_i) {
         for (var w = 0u; w < params.n_walls; w++) {
-            if (!touches_wall(i, w)) { continue; }
+            if (!is_wall_candidate(i, w)) { continue; }
             if (n == MAX_CONTACTS) { halt(HALT_CONTACTS_FULL, i); break; }
             found[n] = WALL_BASE + w;
             n++;

@@ -66,6 +66,7 @@ fn insert_place() {
                              cand.radius_units, cand.radius_rem, cand.shape);
             rotate_corners(n, st);
             atomicStore(&control[C_LIVE], n + 1u);
+            request_rebuild();
             sources[s].inserted = k + 1u;
         }
     }

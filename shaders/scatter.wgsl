@@ -7,13 +7,13 @@
 @compute @workgroup_size(WG)
 fn clear_cursor(@builtin(global_invocation_id) gid: vec3<u32>) {
     let c = gid.x;
-    if (c < params.cells) { atomicStore(&cell_count[c], 0u); }
+    if (c < params.cells && rebuilding()) { atomicStore(&cell_count[c], 0u); }
 }
 
 @compute @workgroup_size(WG)
 fn scatter(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= params.n_cap || cell_of[i] == EMPTY) { return; }
+    if (i >= params.n_cap || cell_of[i] == EMPTY || !rebuilding()) { return; }
     let c = cell_of[i];
     let slot = cell_start[c] + atomicAdd(&cell_count[c], 1u);
     sorted[slot] = i;

@@ -1,20 +1,27 @@
-// Stage (src/springs.rs `store_history`): a fresh table holding the updated history of
-// this step's contacts. A contact that closed is simply not carried over: no deletion,
-// no tombstones, and a contact that opens and closes within a step is never seen twice.
+// Stage (src/neighbours.rs `table`; at a rebuild of the lists only, before the new lists
+// are built): a fresh table holding the springs of the old lists' candidates that touch.
+// A contact that closed is simply not carried over: no deletion, no tombstones. After an
+// upload the table already holds the springs (TABLE_CURRENT) and is kept; the host may
+// ask for the table of the current lists between steps (FLUSH).
+
+fn storing() -> bool {
+    let w = lists_word();
+    return (w & (REBUILD | FLUSH)) != 0u && (w & TABLE_CURRENT) == 0u;
+}
 
 @compute @workgroup_size(WG)
 fn clear_table(@builtin(global_invocation_id) gid: vec3<u32>) {
     let s = gid.x;
-    if (s <= params.table_mask) { atomicStore(&table_new[s].i, EMPTY); }
+    if (s <= params.table_mask && storing()) { atomicStore(&table[s].i, EMPTY); }
 }
 
-fn insert_new(i: u32, j: u32, value: f32) {
+fn insert(i: u32, j: u32, value: f32) {
     var slot = hash_pair(i, j) & params.table_mask;
     for (var probe = 0u; probe <= params.table_mask; probe++) {
-        let r = atomicCompareExchangeWeak(&table_new[slot].i, EMPTY, i);
+        let r = atomicCompareExchangeWeak(&table[slot].i, EMPTY, i);
         if (r.exchanged) {
-            table_new[slot].j = j;
-            table_new[slot].value = value;
+            table[slot].j = j;
+            table[slot].value = value;
             return;
         }
         if (r.old_value == EMPTY) { continue; } // spurious failure: try the slot again
@@ -26,9 +33,9 @@ fn insert_new(i: u32, j: u32, value: f32) {
 @compute @workgroup_size(WG)
 fn store_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= live() || halted()) { return; }
+    if (i >= live() || halted() || !storing()) { return; }
     for (var k = 0u; k < contact_count[i]; k++) {
         let slot = i * MAX_CONTACTS + k;
-        insert_new(i, contact_j[slot], hist_out[slot]);
+        if (touching[slot] != 0u) { insert(i, contact_j[slot], hist_in[slot]); }
     }
 }

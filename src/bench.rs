@@ -26,8 +26,8 @@ pub struct Measurement {
     pub steps: u64,
     pub seconds: f64,
     pub particle_steps_per_second: f64,
-    /// CPU path: neighbour-list rebuilds per 1000 steps, and candidate pairs and
-    /// contacts per particle at the end (issue 13).
+    /// Neighbour-list rebuilds per 1000 steps (both paths), and on the CPU path the
+    /// candidate pairs and contacts per particle at the end (issue 13).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub rebuilds_per_1000_steps: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -117,7 +117,7 @@ fn measure(
     let n0 = e.active_count();
     let rebuilds0 = match &e {
         Engine::Cpu(s) => s.neighbours.rebuilds,
-        Engine::Gpu(_) => 0,
+        Engine::Gpu(g) => g.rebuilds(),
     };
     let t = Instant::now();
     e.advance(steps).map_err(|d| d.to_string())?;
@@ -132,7 +132,11 @@ fn measure(
                 per(s.pairs.len()),
             )
         }
-        Engine::Gpu(_) => (None, None, None),
+        Engine::Gpu(g) => (
+            Some(1000.0 * (g.rebuilds() - rebuilds0) as f64 / steps as f64),
+            None,
+            None,
+        ),
     };
     Ok(Measurement {
         workload: workload.into(),
@@ -210,6 +214,7 @@ pub fn run(
                 (Some(r), Some(p)) => {
                     format!(", {r:.0} rebuilds per 1000 steps, {p:.2} pairs per particle")
                 }
+                (Some(r), None) => format!(", {r:.0} rebuilds per 1000 steps"),
                 _ => String::new(),
             };
             log(format!(

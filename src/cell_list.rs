@@ -34,6 +34,20 @@ impl Grid {
         }
     }
 
+    /// This grid with its cells doubled until they are at least `min_cell` wide (the
+    /// same origin; the last cells may reach beyond the domain): the GPU path's grid for
+    /// the neighbour lists. Its fixed-point unit is the old one times a power of two, so
+    /// positions that lay on the old grid's units lie on the new one's.
+    pub fn coarsened(&self, min_cell: f64) -> Self {
+        let mut g = self.clone();
+        while g.cell_size < min_cell {
+            g.cell_size *= 2.0;
+            g.nx = g.nx.div_ceil(2);
+            g.nz = g.nz.div_ceil(2);
+        }
+        g
+    }
+
     pub fn cell_count(&self) -> usize {
         self.nx as usize * self.nz as usize
     }

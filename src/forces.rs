@@ -328,8 +328,8 @@ fn candidates_with<L: Law>(
             }
             for (m, (kick, h)) in kicks.iter_mut().zip(h).enumerate() {
                 let k = k0 + m;
-                let r = geometry[m]
-                    .map(|g| disk_candidate_force(s, law, pairs[m], list.history[k], g));
+                let r =
+                    geometry[m].map(|g| disk_candidate_force(s, law, pairs[m], list.history[k], g));
                 settle(k, r, kick, h);
             }
         };

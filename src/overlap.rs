@@ -238,7 +238,7 @@ enum Side {
 fn circle_side(centre: f64, r: f64, m: P2) -> Side {
     let (c2, r2) = (centre * centre, r * r * dot(m, m));
     // (Squares of lengths below 1e-140 lose bits to underflow: no shortcut there.)
-    if !(r2 > 1e-280) {
+    if r2.is_nan() || r2 <= 1e-280 {
         return circle_side_exact(centre, r, m);
     }
     if c2 < r2 * (1.0 - 1e-9) {

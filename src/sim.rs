@@ -6,8 +6,8 @@ use crate::cell_list::Grid;
 use crate::contacts::Pair;
 use crate::create::{self, source::SourceState};
 use crate::forces::{
-    CandidateResults, ContactForce, StepState, candidate_forces, overlap_ratio,
-    kick_sum, reduce_candidate_forces,
+    CandidateResults, ContactForce, StepState, candidate_forces, kick_sum, overlap_ratio,
+    reduce_candidate_forces,
 };
 use crate::geometry::WallSegment;
 use crate::integrate::{gear, leapfrog};

@@ -11,6 +11,7 @@ use talus::contacts::{Pair, find_contacts};
 use talus::forces::{contact_forces, reduce_forces};
 use talus::gpu::GpuSimulation;
 use talus::gpu::kernels::Kernel;
+use talus::gpu::layout::control::REBUILD;
 use talus::gpu::layout::{Entry, MAX_CONTACTS};
 use talus::rng::Rng;
 use talus::shape::{RotatedCorners, rotate_corners};
@@ -80,7 +81,7 @@ fn continuous() -> serde_json::Value {
 
 /// The CPU grid the GPU uses: the same origin, and the cell size rounded up to f32.
 fn gpu_grid(g: &GpuSimulation) -> Grid {
-    let mut grid = g.sim.grid.clone();
+    let mut grid = g.grid.clone();
     grid.cell_size = g.params.cell_size as f64;
     grid
 }
@@ -90,8 +91,9 @@ fn setup(test: &str, v: &serde_json::Value) -> Option<GpuSimulation> {
     Some(GpuSimulation::with_gpu(common::sim(v), gpu).expect("uploads"))
 }
 
-/// Runs the cell list and find_contacts on the GPU; returns its pairs in list order.
-fn gpu_pairs(g: &mut GpuSimulation) -> Vec<Pair> {
+/// Runs the cell list and find_contacts on the GPU (a rebuild of the neighbour lists);
+/// returns the candidates in list order.
+fn gpu_candidates(g: &mut GpuSimulation) -> Vec<Pair> {
     let mut ks = GpuSimulation::CELL_LIST.to_vec();
     ks.push(Kernel::FindContacts);
     g.run_kernels(&ks);
@@ -108,6 +110,35 @@ fn gpu_pairs(g: &mut GpuSimulation) -> Vec<Pair> {
         }
     }
     pairs
+}
+
+/// The slots (i · MAX_CONTACTS + k) of the candidates that touched at the last
+/// contact_forces, in list order.
+fn touching_slots(g: &GpuSimulation) -> Vec<usize> {
+    let n = g.live() as usize;
+    let m = MAX_CONTACTS as usize;
+    let count = g.read_u32("contact_count", n);
+    let touching = g.read_u32("touching", n * m);
+    (0..n)
+        .flat_map(|i| (0..count[i] as usize).map(move |k| i * m + k))
+        .filter(|&s| touching[s] != 0)
+        .collect()
+}
+
+/// The GPU's contacts: the candidates of a rebuild that touch at the evaluation.
+fn gpu_pairs(g: &mut GpuSimulation) -> Vec<Pair> {
+    gpu_candidates(g);
+    g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces]);
+    let m = MAX_CONTACTS as usize;
+    let js = g.read_u32("contact_j", g.live() as usize * m);
+    let slots = touching_slots(g);
+    slots
+        .into_iter()
+        .map(|s| Pair {
+            i: (s / m) as u32,
+            j: js[s],
+        })
+        .collect()
 }
 
 #[test]
@@ -150,9 +181,10 @@ fn cell_list_matches_the_cpu() {
 
 #[test]
 fn prefix_sum_matches_the_cpu_on_all_three_levels() {
-    // A domain of 400 × 400 cells: 160 000 counts, 625 level-1 blocks, 3 level-2 blocks.
+    // A domain of 400 × 400 cells (of 2 d: the unit cells doubled to hold the
+    // neighbour lists' skin): 160 000 counts, 625 level-1 blocks, 3 level-2 blocks.
     let mut v = random_scene(20, spring_dashpot(), 2);
-    v["domain"] = json!({ "x": [-3.0, 397.0], "z": [-3.0, 397.0] });
+    v["domain"] = json!({ "x": [-3.0, 797.0], "z": [-3.0, 797.0] });
     let Some(mut g) = setup("prefix_sum_matches_the_cpu_on_all_three_levels", &v) else {
         return;
     };
@@ -279,61 +311,57 @@ fn contact_forces_and_reduction_match_the_cpu() {
                 _pad: 0,
             })
             .collect();
+        // The table is read at a rebuild: the contacts' slots get their springs, the
+        // other candidates' 0.
         g.upload_springs(&entries);
-        g.run_kernels(&[
-            Kernel::GatherHistory,
-            Kernel::ContactForces,
-            Kernel::ReduceForces,
-        ]);
+        g.run_kernels(&[Kernel::GatherHistory]);
+        let n = g.live() as usize;
+        let slots = touching_slots(&g);
+        let hist_in = g.read_f32("hist_in", n * MAX_CONTACTS as usize);
+        for (k_global, &slot) in slots.iter().enumerate() {
+            assert_eq!(
+                hist_in[slot], entries[k_global].value,
+                "{name}: gathered history"
+            );
+        }
+        let listed = g.read_u32("contact_count", n).iter().sum::<u32>() as usize;
+        let zeros = hist_in.iter().filter(|h| **h == 0.0).count();
+        assert!(
+            zeros + slots.len() >= listed,
+            "{name}: other candidates start at 0"
+        );
+        g.run_kernels(&[Kernel::ContactForces, Kernel::ReduceForces]);
+        assert_eq!(touching_slots(&g), slots, "{name}: the same contacts");
         let host = g.download().clone();
         let history: Vec<f64> = entries.iter().map(|e| e.value as f64).collect();
-        let n = host.particles.len();
-        let hist_in = g.read_f32("hist_in", n * MAX_CONTACTS as usize);
-        let count = g.read_u32("contact_count", n);
-        let mut k_global = 0;
-        for i in 0..n {
-            for k in 0..count[i] as usize {
-                assert_eq!(
-                    hist_in[i * MAX_CONTACTS as usize + k],
-                    entries[k_global].value,
-                    "{name}: gathered history"
-                );
-                k_global += 1;
-            }
-        }
         let (cpu, hist_out) = cpu_contact_forces(&host, &pairs, &history);
         let scale = cpu.iter().map(|c| c.f_n.abs()).fold(0.0, f64::max);
         assert!(scale > 0.0);
         let out = g.read_contact_out(n * MAX_CONTACTS as usize);
-        let gpu_hist = g.read_f32("hist_out", n * MAX_CONTACTS as usize);
+        // The history is updated in the slot.
+        let gpu_hist = g.read_f32("hist_in", n * MAX_CONTACTS as usize);
         let mut worst: f64 = 0.0;
-        let mut k_global = 0;
         let hscale = hist_out.iter().map(|h| h.abs()).fold(1e-12, f64::max);
-        for i in 0..n {
-            for k in 0..count[i] as usize {
-                let o = out[i * MAX_CONTACTS as usize + k];
+        for (k_global, &slot) in slots.iter().enumerate() {
+            {
+                let o = out[slot];
                 let c = cpu[k_global];
                 worst = worst
                     .max(rel(o.ft[0] as f64, c.force[0], scale))
                     .max(rel(o.ft[1] as f64, c.force[1], scale))
                     .max(rel(o.info[0] as f64, c.f_n, scale))
                     .max(rel(o.info[1] as f64, c.f_t, scale));
-                let dh = rel(
-                    gpu_hist[i * MAX_CONTACTS as usize + k] as f64,
-                    hist_out[k_global],
-                    hscale,
-                );
+                let dh = rel(gpu_hist[slot] as f64, hist_out[k_global], hscale);
                 assert!(
                     dh < 1e-4,
                     "{name}: history of contact {k_global} {:?} differs by {dh:.2e}: gpu {} cpu {} (in {}), gpu out {:?} cpu {:?}",
                     pairs[k_global],
-                    gpu_hist[i * MAX_CONTACTS as usize + k],
+                    gpu_hist[slot],
                     hist_out[k_global],
                     history[k_global],
                     o,
                     c
                 );
-                k_global += 1;
             }
         }
         assert!(
@@ -402,7 +430,8 @@ fn spring_table_survives_contact_churn() {
                 next.insert((i as u32, j), v);
             }
         }
-        g.upload_contacts(&count, &js, &values);
+        // A rebuild: the new lists take their springs from the table...
+        g.upload_contacts(&count, &js, &vec![0.0; n * m]);
         g.run_kernels(&[Kernel::GatherHistory]);
         let hist = g.read_f32("hist_in", n * m);
         for i in 0..n {
@@ -412,8 +441,10 @@ fn spring_table_survives_contact_churn() {
                 assert_eq!(hist[i * m + k], want, "step {step}: pair ({i}, {j})");
             }
         }
+        // ...which the next rebuild fills from these lists' springs.
+        g.upload_contacts(&count, &js, &values);
+        g.set_list_flags(REBUILD);
         g.run_kernels(&[Kernel::ClearTable, Kernel::StoreHistory]);
-        g.swap_springs();
         let stored = g.download().springs.len();
         assert_eq!(
             stored,
@@ -704,21 +735,15 @@ fn gpu_and_cpu_overlaps(
     let gpu = common::gpu(test)?;
     let mut g = GpuSimulation::with_gpu(sim, gpu).expect("uploads");
     let pairs = gpu_pairs(&mut g);
-    g.run_kernels(&[Kernel::GatherHistory, Kernel::ContactForces]);
     let host = g.download().clone();
     let n = host.particles.len();
     let (cpu, _) = cpu_contact_forces(&host, &pairs, &vec![0.0; pairs.len()]);
     let out = g.read_contact_out(n * MAX_CONTACTS as usize);
-    let count = g.read_u32("contact_count", n);
-    let mut rows = Vec::new();
-    let mut k_global = 0;
-    for i in 0..n {
-        for k in 0..count[i] as usize {
-            let o = out[i * MAX_CONTACTS as usize + k];
-            rows.push((pairs[k_global], o.info[2] as f64, cpu[k_global].overlap));
-            k_global += 1;
-        }
-    }
+    let rows = touching_slots(&g)
+        .into_iter()
+        .enumerate()
+        .map(|(k, slot)| (pairs[k], out[slot].info[2] as f64, cpu[k].overlap))
+        .collect();
     Some((host, rows))
 }
 

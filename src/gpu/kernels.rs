@@ -35,6 +35,15 @@ pub const MODULES: &[ModuleSource] = &[
         ],
     },
     ModuleSource {
+        name: "survey",
+        parts: &[
+            COMMON,
+            POSITION,
+            ORIENTATION,
+            include_str!("../../shaders/survey.wgsl"),
+        ],
+    },
+    ModuleSource {
         name: "cell_index",
         parts: &[
             COMMON,
@@ -161,6 +170,7 @@ pub enum Kernel {
     InsertCheck,
     InsertPlace,
     Predict,
+    Survey,
     ClearCells,
     CellIndex,
     CellHistogram,
@@ -184,10 +194,11 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 23] = [
+    pub const ALL: [Kernel; 24] = [
         Kernel::InsertCheck,
         Kernel::InsertPlace,
         Kernel::Predict,
+        Kernel::Survey,
         Kernel::ClearCells,
         Kernel::CellIndex,
         Kernel::CellHistogram,
@@ -216,6 +227,7 @@ impl Kernel {
             Kernel::InsertCheck => ("insert", "insert_check"),
             Kernel::InsertPlace => ("insert", "insert_place"),
             Kernel::Predict => ("predict", "predict"),
+            Kernel::Survey => ("survey", "survey"),
             Kernel::ClearCells => ("cell_index", "clear_cells"),
             Kernel::CellIndex => ("cell_index", "cell_index"),
             Kernel::CellHistogram => ("cell_histogram", "cell_histogram"),
@@ -242,7 +254,7 @@ impl Kernel {
 
 /// Storage bindings of group 0 (binding 0 is the uniform Params) and of group 1.
 pub const GROUP0_STORAGE: u32 = 20;
-pub const GROUP1_STORAGE: u32 = 2;
+pub const GROUP1_STORAGE: u32 = 1;
 
 fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {

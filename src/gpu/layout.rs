@@ -25,6 +25,13 @@ pub mod control {
     pub const HALT: usize = 3;
     pub const HALT_STEP: usize = 4;
     pub const HALT_ID: usize = 5;
+    /// The neighbour lists' word, and its bits (`C_LISTS`, `REBUILD`, … in common.wgsl).
+    pub const LISTS: usize = 6;
+    pub const REBUILD: u32 = 1;
+    pub const TABLE_CURRENT: u32 = 2;
+    pub const FLUSH: u32 = 4;
+    /// How many times the device built the lists (`C_REBUILDS`).
+    pub const REBUILDS: usize = 7;
     pub const BLOCKED: usize = 8;
     pub const HALT_OVERLAP: u32 = 1;
     pub const HALT_NOT_FINITE: u32 = 2;
@@ -77,7 +84,8 @@ pub struct Params {
     /// Fixed-point unit, cell_size / 2^30 (`position.wgsl`), and its inverse.
     pub unit: f32,
     pub inv_unit: f32,
-    pub _pad: u32,
+    /// The neighbour lists' skin (length units).
+    pub skin: f32,
 }
 
 /// Dynamic state of one particle: q[0] = (rem_x, rem_z, rem_θ, 0) and the scaled Gear
@@ -92,7 +100,10 @@ pub struct State {
     /// Orientation in whole turn units of 2π/2³² (see `orientation`); the remainder is
     /// q[0][2].
     pub turn: u32,
-    pub _pad: [u32; 3],
+    /// Where the particle was when the lists were built: its anchor as two i16 halves,
+    /// and its frac (the survey kernel's displacement test).
+    pub listed_anchor: u32,
+    pub listed_frac: [u32; 2],
 }
 
 #[repr(C)]
@@ -233,10 +244,14 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 scan_offset2,
                 unit,
                 inv_unit,
-                _pad
+                skin
             ]
         ),
-        fields!(State, "State", [q, anchor, frac, turn, _pad]),
+        fields!(
+            State,
+            "State",
+            [q, anchor, frac, turn, listed_anchor, listed_frac]
+        ),
         fields!(
             Props,
             "Props",

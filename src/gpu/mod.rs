@@ -53,7 +53,7 @@ struct Buffers {
     down: wgpu::Buffer,
     down_count: wgpu::Buffer,
     hist_in: wgpu::Buffer,
-    hist_out: wgpu::Buffer,
+    touching: wgpu::Buffer,
     contact_out: wgpu::Buffer,
     force: wgpu::Buffer,
     walls: wgpu::Buffer,
@@ -61,7 +61,7 @@ struct Buffers {
     sources: wgpu::Buffer,
     candidates: wgpu::Buffer,
     corners: wgpu::Buffer,
-    tables: [wgpu::Buffer; 2],
+    table: wgpu::Buffer,
 }
 
 /// The source bookkeeping of the host: where each source stood at upload.
@@ -85,11 +85,12 @@ pub struct GpuSimulation {
     pipelines: Pipelines,
     buffers: Buffers,
     group0: wgpu::BindGroup,
-    /// group1[p]: table p is "old" (read), the other is "new" (written).
-    group1: [wgpu::BindGroup; 2],
-    /// Which table holds the springs of the last completed step.
-    parity: usize,
+    /// The spring table's group.
+    group1: wgpu::BindGroup,
     pub params: Params,
+    /// The device's grid: cells of at least the law's range plus the neighbour lists'
+    /// skin (positions are anchored to its cells, see `position`).
+    pub grid: crate::cell_list::Grid,
     n_cap: u32,
     origin: [f64; 2],
     /// The corners in the device's corner buffer, in f64 (shapes of downloaded particles).
@@ -149,7 +150,12 @@ impl GpuSimulation {
             ));
         }
         let device_state = sim.device_state.take();
-        let grid = sim.grid.clone();
+        // Cells hold every candidate within range + skin of the lists (issue 13): the
+        // law's grid with its cells doubled (the fixed-point unit scales by a power of
+        // two; any other size loses the lattice piles' exact alignment, see
+        // tests/gpu_scenes.rs `lattice_pile_agrees_with_the_cpu`).
+        let skin = sim.skin();
+        let grid = sim.grid.coarsened(sim.grid.cell_size + skin);
         let cells = grid.cell_count() as u64;
         if cells > MAX_CELLS {
             return Err(DeviceError::TooLarge {
@@ -291,6 +297,7 @@ impl GpuSimulation {
             scan_offset2: blocks1.next_multiple_of(SCAN_WG),
             unit: position::unit(cell_size) as f32,
             inv_unit: (1.0 / position::unit(cell_size)) as f32,
+            skin: skin as f32,
             ..Default::default()
         };
         law_params(law, &mut params);
@@ -355,6 +362,8 @@ impl GpuSimulation {
         control[control::LIVE] = n_now;
         control[control::HALT_STEP] = u32::MAX;
         control[control::HALT_ID] = u32::MAX;
+        // The first step builds the lists, with the springs of the table uploaded now.
+        control[control::LISTS] = control::REBUILD | control::TABLE_CURRENT;
 
         let (states, props, entries) = match device_state {
             Some(mut ds) => {
@@ -403,7 +412,7 @@ impl GpuSimulation {
             down: zeroed("down", n * m * 4),
             down_count: zeroed("down_count", n * 4),
             hist_in: zeroed("hist_in", n * m * 4),
-            hist_out: zeroed("hist_out", n * m * 4),
+            touching: zeroed("touching", n * m * 4),
             contact_out: zeroed("contact_out", n * m * size_of::<ContactOut>() as u64),
             force: zeroed("force", n * 16),
             walls: init("walls", bytemuck::cast_slice(&walls)),
@@ -423,10 +432,7 @@ impl GpuSimulation {
                     c
                 }),
             ),
-            tables: [
-                init("springs 0", bytemuck::cast_slice(&table)),
-                init("springs 1", bytemuck::cast_slice(&table)),
-            ],
+            table: init("springs", bytemuck::cast_slice(&table)),
         };
         let pipelines = Pipelines::new(dev, matches!(sim.law, ContactLaw::OverlapArea(_)));
         let b = &buffers;
@@ -444,7 +450,7 @@ impl GpuSimulation {
             &b.down,
             &b.down_count,
             &b.hist_in,
-            &b.hist_out,
+            &b.touching,
             &b.contact_out,
             &b.force,
             &b.walls,
@@ -466,23 +472,14 @@ impl GpuSimulation {
             layout: &pipelines.group0,
             entries: &entries0,
         });
-        let pair_group = |old: usize| {
-            dev.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("springs"),
-                layout: &pipelines.group1,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: b.tables[old].as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: b.tables[1 - old].as_entire_binding(),
-                    },
-                ],
-            })
-        };
-        let group1 = [pair_group(0), pair_group(1)];
+        let group1 = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("springs"),
+            layout: &pipelines.group1,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: b.table.as_entire_binding(),
+            }],
+        });
         let lost_base = sim.lost;
         let inactive_at_upload = (sim.particles.len() - sim.particles.active_count()) as u64;
         let step = sim.step;
@@ -493,8 +490,8 @@ impl GpuSimulation {
             buffers,
             group0,
             group1,
-            parity: 0,
             params,
+            grid,
             n_cap,
             origin,
             corner_table,
@@ -521,6 +518,11 @@ impl GpuSimulation {
     /// Particles created so far (active or lost).
     pub fn live(&self) -> u32 {
         self.live
+    }
+
+    /// How many times the device has built the neighbour lists since the upload.
+    pub fn rebuilds(&self) -> u64 {
+        self.read_control()[control::REBUILDS] as u64
     }
 
     /// Active particles after the last submission (from the control words).
@@ -558,7 +560,7 @@ impl GpuSimulation {
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
             pass.set_bind_group(0, &self.group0, &[]);
-            pass.set_bind_group(1, &self.group1[self.parity], &[]);
+            pass.set_bind_group(1, &self.group1, &[]);
             for &k in ks {
                 self.encode_kernel(&mut pass, k);
             }
@@ -582,8 +584,7 @@ impl GpuSimulation {
     ];
 
     /// One time step, stage by stage as in `Simulation::step`.
-    fn encode_step(&self, pass: &mut wgpu::ComputePass, parity: usize, sources_left: bool) {
-        pass.set_bind_group(1, &self.group1[parity], &[]);
+    fn encode_step(&self, pass: &mut wgpu::ComputePass, sources_left: bool) {
         if sources_left {
             self.encode_kernel(pass, Kernel::InsertCheck);
             self.encode_kernel(pass, Kernel::InsertPlace);
@@ -592,6 +593,12 @@ impl GpuSimulation {
         if gear {
             self.encode_kernel(pass, Kernel::Predict);
         }
+        // The neighbour lists (issue 13): the survey decides whether this step rebuilds
+        // them; the stages of a rebuild (the old lists' springs into the table, the cell
+        // list, the new lists, their springs from the table) return at once otherwise.
+        for k in [Kernel::Survey, Kernel::ClearTable, Kernel::StoreHistory] {
+            self.encode_kernel(pass, k);
+        }
         for k in Self::CELL_LIST {
             self.encode_kernel(pass, k);
         }
@@ -599,8 +606,6 @@ impl GpuSimulation {
             Kernel::FindContacts,
             Kernel::GatherHistory,
             Kernel::ContactForces,
-            Kernel::ClearTable,
-            Kernel::StoreHistory,
             Kernel::ReduceForces,
         ] {
             self.encode_kernel(pass, k);
@@ -642,9 +647,9 @@ impl GpuSimulation {
             {
                 let mut pass = enc.begin_compute_pass(&Default::default());
                 pass.set_bind_group(0, &self.group0, &[]);
-                for s in 0..k {
-                    let parity = (self.parity + s as usize) % 2;
-                    self.encode_step(&mut pass, parity, sources_left);
+                pass.set_bind_group(1, &self.group1, &[]);
+                for _ in 0..k {
+                    self.encode_step(&mut pass, sources_left);
                 }
             }
             self.gpu.queue.submit([enc.finish()]);
@@ -655,7 +660,6 @@ impl GpuSimulation {
             if c[control::HALT] != 0 {
                 return Err(self.halt_cause(&c));
             }
-            self.parity = (self.parity + k as usize) % 2;
             self.step += k;
             left -= k;
         }
@@ -740,14 +744,16 @@ impl GpuSimulation {
             (control::LIVE * 4) as u64,
             bytemuck::bytes_of(&self.live),
         );
+        // New particles: the next step rebuilds the lists.
+        let flags = self.read_control()[control::LISTS];
+        self.write_lists_word(flags | control::REBUILD);
         self.synced = false;
     }
 
     fn halt_cause(&mut self, c: &[u32]) -> Divergence {
         // The device stopped inside the last submission, at the start of step
-        // `halt_step`; the steps before it completed (and flipped the tables).
+        // `halt_step`; the steps before it completed.
         let halt_step = c[control::HALT_STEP] as u64;
-        self.parity = (self.parity + (halt_step - self.step) as usize) % 2;
         self.step = halt_step;
         let id = c[control::HALT_ID];
         let flags = c[control::HALT];
@@ -875,13 +881,15 @@ impl GpuSimulation {
         let count: Vec<u32> = self.read_buffer(&self.buffers.contact_count, 0, live);
         let js: Vec<u32> = self.read_buffer(&self.buffers.contact_j, 0, live * m);
         let outs: Vec<ContactOut> = self.read_buffer(&self.buffers.contact_out, 0, live * m);
+        let touching: Vec<u32> = self.read_buffer(&self.buffers.touching, 0, live * m);
         let mut pairs = Vec::new();
         let mut contacts = Vec::new();
         // Every contact as the device computed it: its force, normal and contact point
         // (relative to i's centre), converted exactly from f32 (issue 19).
         let parts = &self.sim.particles;
         for i in 0..live {
-            for k in 0..count[i] as usize {
+            // The lists' candidates that touch: the contacts.
+            for k in (0..count[i] as usize).filter(|&k| touching[i * m + k] != 0) {
                 let j = js[i * m + k];
                 let o = outs[i * m + k];
                 let p = parts.position(i);
@@ -912,10 +920,17 @@ impl GpuSimulation {
     /// The exact device state (for checkpoints).
     pub fn device_state(&self) -> DeviceState {
         let live = self.read_control()[control::LIVE] as usize;
-        let states = self.read_buffer(&self.buffers.state, 0, live);
+        let mut states: Vec<State> = self.read_buffer(&self.buffers.state, 0, live);
+        // Where each particle was at the last rebuild belongs to the lists, not to the
+        // state: an upload rebuilds them (and a resumed run may rebuild on other steps).
+        for s in &mut states {
+            s.listed_anchor = 0;
+            s.listed_frac = [0; 2];
+        }
         let props = self.read_buffer(&self.buffers.props, 0, live);
         let cap = self.params.table_mask as usize + 1;
-        let table: Vec<Entry> = self.read_buffer(&self.buffers.tables[self.parity], 0, cap);
+        self.flush_table();
+        let table: Vec<Entry> = self.read_buffer(&self.buffers.table, 0, cap);
         let mut springs: Vec<Entry> = table.into_iter().filter(|e| e.i != EMPTY).collect();
         springs.sort_by_key(|e| (e.i, e.j));
         DeviceState {
@@ -936,28 +951,62 @@ impl GpuSimulation {
         self.write_buffer(&p_buf, &pr);
     }
 
-    /// Overwrites the spring table of the previous step (tests).
+    /// Makes the spring table hold the springs of the current lists (those of the
+    /// candidates that touched at the last step), unless it already holds the springs
+    /// (nothing has run since an upload). Between steps the springs live in the lists'
+    /// slots; the table is written only at a rebuild (issue 13).
+    fn flush_table(&self) {
+        let flags = self.read_control()[control::LISTS];
+        if flags & control::TABLE_CURRENT != 0 {
+            return;
+        }
+        self.write_lists_word(control::FLUSH);
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &self.group0, &[]);
+            pass.set_bind_group(1, &self.group1, &[]);
+            self.encode_kernel(&mut pass, Kernel::ClearTable);
+            self.encode_kernel(&mut pass, Kernel::StoreHistory);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.write_lists_word(flags);
+    }
+
+    fn write_lists_word(&self, flags: u32) {
+        self.gpu.queue.write_buffer(
+            &self.buffers.control,
+            (control::LISTS * 4) as u64,
+            bytemuck::bytes_of(&flags),
+        );
+    }
+
+    /// Sets the neighbour lists' word (`control::REBUILD`, …; tests of single kernels).
+    pub fn set_list_flags(&mut self, flags: u32) {
+        self.write_lists_word(flags);
+        self.synced = false;
+    }
+
+    /// Overwrites the spring table (tests); the next rebuild takes its springs from it.
     pub fn upload_springs(&mut self, entries: &[Entry]) {
         let table = build_table(entries, self.params.table_mask as usize + 1);
-        let buf = self.buffers.tables[self.parity].clone();
+        let buf = self.buffers.table.clone();
         self.write_buffer(&buf, &table);
+        self.set_list_flags(control::REBUILD | control::TABLE_CURRENT);
     }
 
-    /// Makes the table written by the last store_history the one read next (tests).
-    pub fn swap_springs(&mut self) {
-        self.parity = 1 - self.parity;
-    }
-
-    /// Overwrites contact lists and the history written by the force stage (tests).
-    pub fn upload_contacts(&mut self, count: &[u32], js: &[u32], hist_out: &[f32]) {
-        let (a, b, c) = (
+    /// Overwrites the lists and their springs, every candidate touching (tests).
+    pub fn upload_contacts(&mut self, count: &[u32], js: &[u32], history: &[f32]) {
+        let (a, b, c, d) = (
             self.buffers.contact_count.clone(),
             self.buffers.contact_j.clone(),
-            self.buffers.hist_out.clone(),
+            self.buffers.hist_in.clone(),
+            self.buffers.touching.clone(),
         );
         self.write_buffer(&a, count);
         self.write_buffer(&b, js);
-        self.write_buffer(&c, hist_out);
+        self.write_buffer(&c, history);
+        self.write_buffer(&d, &vec![1u32; js.len()]);
     }
 
     pub fn upload_cell_counts(&mut self, counts: &[u32]) {
@@ -975,6 +1024,7 @@ impl GpuSimulation {
             "sorted" => &b.sorted,
             "contact_j" => &b.contact_j,
             "contact_count" => &b.contact_count,
+            "touching" => &b.touching,
             "control" => &b.control,
             _ => panic!("unknown buffer {name}"),
         };
@@ -985,7 +1035,6 @@ impl GpuSimulation {
         let b = &self.buffers;
         let buf = match name {
             "hist_in" => &b.hist_in,
-            "hist_out" => &b.hist_out,
             _ => panic!("unknown buffer {name}"),
         };
         self.read_buffer(buf, 0, count)

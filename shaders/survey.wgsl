@@ -1,0 +1,28 @@
+// Stage (src/sim.rs `survey`, src/neighbours.rs `moved`): after the prediction, whether
+// a particle has moved by more than skin/2 since the lists were built; then this step
+// rebuilds them. The displacement comes from the fixed-point position (whole cells and
+// units), so the decision is the same on every run. Insertions and removals ask for a
+// rebuild where they happen (insert, boundaries).
+
+fn moved(s: State) -> bool {
+    // The anchor when listed, from its two 16-bit halves; anchors move by far less than
+    // 2^15 cells between two rebuilds, so the wrapped difference is the true one.
+    let la = vec2<i32>(i32(s.listed_anchor << 16u) >> 16u, i32(s.listed_anchor) >> 16u);
+    let da = ((s.anchor - la + vec2<i32>(32768)) & vec2<i32>(0xFFFF)) - vec2<i32>(32768);
+    if (any(abs(da) > vec2<i32>(1))) { return true; }
+    let d = vec2<f32>(da) * f32(FRAC_ONE) + vec2<f32>(vec2<i32>(s.frac) - vec2<i32>(s.listed_frac));
+    // skin/2 in units, a hair smaller for the f32 rounding of d.
+    let half = 0.5 * params.skin * params.inv_unit * (1.0 - 1.0e-4);
+    return dot(d, d) > half * half;
+}
+
+@compute @workgroup_size(WG)
+fn survey(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= live() || halted()) { return; }
+    if (params.skin <= 0.0) {
+        if (i == 0u) { request_rebuild(); }
+        return;
+    }
+    if (is_active(i) && moved(state[i])) { request_rebuild(); }
+}
