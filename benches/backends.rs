@@ -17,9 +17,15 @@ fn main() {
         eprintln!("no GPU adapter: measuring the CPU path only");
     }
     let polygon_sizes = vec![1000, 10_000, 50_000];
-    match talus::bench::run(&backends, &sizes, &polygon_sizes, 200, true, &mut |l| {
-        eprintln!("{l}")
-    }) {
+    match talus::bench::run(
+        &backends,
+        &sizes,
+        &polygon_sizes,
+        200,
+        None,
+        true,
+        &mut |l| eprintln!("{l}"),
+    ) {
         Ok(r) => println!("{}", serde_json::to_string_pretty(&r).unwrap()),
         Err(e) => {
             eprintln!("error: {e}");

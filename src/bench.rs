@@ -26,6 +26,14 @@ pub struct Measurement {
     pub steps: u64,
     pub seconds: f64,
     pub particle_steps_per_second: f64,
+    pub steps_per_second: f64,
+    pub microseconds_per_step: f64,
+    /// GPU path: compute dispatches and queue submissions (batches of steps and
+    /// readbacks) per step.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dispatches_per_step: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub submissions_per_step: Option<f64>,
     /// Neighbour-list rebuilds per 1000 steps (both paths), and on the CPU path the
     /// candidate pairs and contacts per particle at the end (issue 13).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -43,6 +51,16 @@ pub struct Report {
     /// Threads of the CPU path.
     pub threads: usize,
     pub results: Vec<Measurement>,
+    /// Workloads that could not run on a backend (too large for the adapter, a
+    /// divergence), with the reason; the others still ran.
+    pub failures: Vec<Failure>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct Failure {
+    pub workload: String,
+    pub backend: String,
+    pub error: String,
 }
 
 /// A triangular packing of `n` unit disks, about twice as wide as high, on a floor.
@@ -105,23 +123,59 @@ fn engine(sim: Simulation, backend: BackendChoice) -> Result<Engine, String> {
     }
 }
 
-/// Times `steps` steps after a warm-up; the particle count is the mean of start and end.
+fn gpu_counters(e: &Engine) -> Option<(u64, u64)> {
+    match e {
+        Engine::Gpu(g) => Some(g.counters()),
+        Engine::Cpu(_) => None,
+    }
+}
+
+/// Times `steps` steps after a warm-up of a tenth as many, or with a `budget` of
+/// seconds, as many as fit in it (up to `steps`, in doubling batches); the particle
+/// count is the mean of start and end.
 fn measure(
     workload: &str,
     sim: Simulation,
     backend: BackendChoice,
     steps: u64,
+    budget: Option<f64>,
 ) -> Result<Measurement, String> {
     let mut e = engine(sim, backend)?;
-    e.advance((steps / 10).max(1)).map_err(|d| d.to_string())?;
+    let warm = if budget.is_some() { 10 } else { steps / 10 };
+    e.advance(warm.clamp(1, steps.max(1)))
+        .map_err(|d| d.to_string())?;
     let n0 = e.active_count();
+    let counters0 = gpu_counters(&e);
     let rebuilds0 = match &e {
         Engine::Cpu(s) => s.neighbours.rebuilds,
         Engine::Gpu(g) => g.rebuilds(),
     };
     let t = Instant::now();
-    e.advance(steps).map_err(|d| d.to_string())?;
+    let steps = match budget {
+        None => {
+            e.advance(steps).map_err(|d| d.to_string())?;
+            steps
+        }
+        Some(budget) => {
+            let (mut done, mut batch) = (0, 8u64);
+            while done < steps {
+                let k = batch.min(steps - done);
+                e.advance(k).map_err(|d| d.to_string())?;
+                done += k;
+                if t.elapsed().as_secs_f64() >= budget {
+                    break;
+                }
+                batch *= 2;
+            }
+            done
+        }
+    };
     let seconds = t.elapsed().as_secs_f64();
+    let per_step = |c: u64, c0: u64| (c - c0) as f64 / steps as f64;
+    let (dispatches, submissions) = match (counters0, gpu_counters(&e)) {
+        (Some((d0, s0)), Some((d, s))) => (Some(per_step(d, d0)), Some(per_step(s, s0))),
+        _ => (None, None),
+    };
     let n = (n0 + e.active_count()) / 2;
     let (rebuilds, pairs, contacts) = match &e {
         Engine::Cpu(s) => {
@@ -150,6 +204,10 @@ fn measure(
         steps,
         seconds,
         particle_steps_per_second: (n * steps) as f64 / seconds.max(1e-12),
+        steps_per_second: steps as f64 / seconds.max(1e-12),
+        microseconds_per_step: 1e6 * seconds / steps as f64,
+        dispatches_per_step: dispatches,
+        submissions_per_step: submissions,
         rebuilds_per_1000_steps: rebuilds,
         pairs_per_particle: pairs,
         contacts_per_particle: contacts,
@@ -168,16 +226,20 @@ fn cpu_name() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
-/// Runs every workload on every backend; `log` receives one line per measurement.
+/// Runs every workload on every backend; `log` receives one line per measurement. A
+/// workload that cannot run on a backend is recorded in `failures` and the rest go on.
+/// `budget`: seconds per measurement instead of a fixed step count (`steps` at most).
 pub fn run(
     backends: &[BackendChoice],
     sizes: &[usize],
     polygon_sizes: &[usize],
     steps: u64,
+    budget: Option<f64>,
     pour: bool,
     log: &mut dyn FnMut(String),
 ) -> Result<Report, String> {
     let mut results = Vec::new();
+    let mut failures = Vec::new();
     let mut workloads: Vec<(String, String)> = sizes
         .iter()
         .map(|&n| (format!("packing-{n}"), packing_scene(n)))
@@ -209,7 +271,19 @@ pub fn run(
             } else {
                 steps
             };
-            let m = measure(name, sim, b, k)?;
+            let m = match measure(name, sim, b, k, budget) {
+                Ok(m) => m,
+                Err(error) => {
+                    let backend = format!("{b:?}").to_lowercase();
+                    log(format!("{name:>18} {backend:>28} failed: {error}"));
+                    failures.push(Failure {
+                        workload: name.clone(),
+                        backend,
+                        error,
+                    });
+                    continue;
+                }
+            };
             let lists = match (m.rebuilds_per_1000_steps, m.pairs_per_particle) {
                 (Some(r), Some(p)) => {
                     format!(", {r:.0} rebuilds per 1000 steps, {p:.2} pairs per particle")
@@ -217,9 +291,19 @@ pub fn run(
                 (Some(r), None) => format!(", {r:.0} rebuilds per 1000 steps"),
                 _ => String::new(),
             };
+            let gpu = match (m.dispatches_per_step, m.submissions_per_step) {
+                (Some(d), Some(s)) => {
+                    format!(", {d:.1} dispatches and {s:.3} submissions per step")
+                }
+                _ => String::new(),
+            };
             log(format!(
-                "{:>18} {:>28} {:>7} particles {:>10.3e} particle-steps/s{lists}",
-                m.workload, m.backend, m.particles, m.particle_steps_per_second
+                "{:>18} {:>28} {:>7} particles {:>10.3e} particle-steps/s, {:.0} µs per step{lists}{gpu}",
+                m.workload,
+                m.backend,
+                m.particles,
+                m.particle_steps_per_second,
+                m.microseconds_per_step
             ));
             results.push(m);
         }
@@ -229,5 +313,6 @@ pub fn run(
         cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
         threads: rayon::current_num_threads(),
         results,
+        failures,
     })
 }

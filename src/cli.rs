@@ -152,9 +152,14 @@ enum Command {
         /// Sizes (polygons) of the polygon-pile workloads (regular 12-gons).
         #[arg(long, value_delimiter = ',', default_values_t = [1000, 10000, 50000])]
         polygon_sizes: Vec<usize>,
-        /// Steps timed per workload (after a warm-up of a tenth as many).
+        /// Steps timed per workload (after a warm-up of a tenth as many); with --budget,
+        /// the most steps timed.
         #[arg(long, default_value_t = 200)]
         steps: u64,
+        /// Seconds per workload and backend: time as many steps as fit (in doubling
+        /// batches, after a warm-up of 10 steps) instead of a fixed count.
+        #[arg(long)]
+        budget: Option<f64>,
         /// Also time the reduced R4 pour.
         #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
         pour: bool,
@@ -251,9 +256,10 @@ fn command(command: Command) -> ExitCode {
             sizes,
             polygon_sizes,
             steps,
+            budget,
             pour,
             out,
-        } => cmd_bench(&backend, &sizes, &polygon_sizes, steps, pour, out),
+        } => cmd_bench(&backend, &sizes, &polygon_sizes, steps, budget, pour, out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -779,12 +785,25 @@ fn cmd_bench(
     sizes: &[usize],
     polygon_sizes: &[usize],
     steps: u64,
+    budget: Option<f64>,
     pour: bool,
     out: Option<PathBuf>,
 ) -> Result<(), Failure> {
-    let report = bench::run(backends, sizes, polygon_sizes, steps, pour, &mut |line| {
-        eprintln!("{line}")
-    })
+    if let Some(b) = budget.filter(|b| !(*b > 0.0 && b.is_finite())) {
+        return Err(Failure {
+            code: 2,
+            message: format!("--budget must be a positive number of seconds, got {b}"),
+        });
+    }
+    let report = bench::run(
+        backends,
+        sizes,
+        polygon_sizes,
+        steps,
+        budget,
+        pour,
+        &mut |line| eprintln!("{line}"),
+    )
     .map_err(|e| Failure {
         code: 1,
         message: e,
@@ -796,6 +815,15 @@ fn cmd_bench(
             code: 1,
             message: format!("cannot write {}: {e}", path.display()),
         })?;
+    }
+    if !report.failures.is_empty() {
+        return Err(Failure {
+            code: 1,
+            message: format!(
+                "{} of the workloads could not run (listed under \"failures\")",
+                report.failures.len()
+            ),
+        });
     }
     Ok(())
 }

@@ -298,3 +298,46 @@ fn analyze_rejects_a_reversed_fit_range() {
         &["--fit 0.9 0.2", "FROM < TO"],
     );
 }
+
+#[test]
+fn bench_with_a_time_budget_reports_steps_and_microseconds() {
+    // --budget times as many steps as fit (at most --steps), and the JSON carries the
+    // per-step figures scripts/gpu-check collects.
+    let out = tmp("bench").join("bench.json");
+    let (code, stdout, err) = talus(&[
+        "bench",
+        "--backend",
+        "cpu",
+        "--sizes",
+        "200",
+        "--polygon-sizes",
+        "30",
+        "--pour",
+        "false",
+        "--budget",
+        "0.2",
+        "--steps",
+        "100000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "bench runs: {err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("JSON on stdout");
+    let file: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
+    assert_eq!(v, file, "the same report in --out");
+    let results = v["results"].as_array().unwrap();
+    assert_eq!(results.len(), 2);
+    for r in results {
+        let steps = r["steps"].as_u64().unwrap();
+        let seconds = r["seconds"].as_f64().unwrap();
+        assert!(steps >= 8 && steps < 100000, "budgeted steps: {steps}");
+        assert!(
+            seconds >= 0.2 && seconds < 5.0,
+            "within the budget's batch: {seconds}"
+        );
+        let us = r["microseconds_per_step"].as_f64().unwrap();
+        assert!((us * steps as f64 / 1e6 - seconds).abs() < 1e-6 * seconds.max(1.0));
+    }
+    assert_rejected(&["bench", "--budget", "0"], &["--budget"]);
+}

@@ -36,8 +36,11 @@ use wgpu::util::DeviceExt;
 /// control words (divergence check, progress).
 pub const STEPS_PER_SUBMIT: u64 = 64;
 
+/// Workgroups of one dispatch at most (per dimension; the GPU path dispatches in one).
+pub const MAX_WORKGROUPS: u64 = 65535;
+
 /// Cells of the grid at most: one dispatch of `clear_cells` covers 65535 workgroups.
-pub const MAX_CELLS: u64 = 65535 * WG as u64;
+pub const MAX_CELLS: u64 = MAX_WORKGROUPS * WG as u64;
 
 struct Buffers {
     params: wgpu::Buffer,
@@ -106,6 +109,10 @@ pub struct GpuSimulation {
     step: u64,
     live: u32,
     synced: bool,
+    /// Dispatches encoded and submissions made (compute and readback) since the upload:
+    /// what `talus bench` reports per step.
+    dispatches: std::cell::Cell<u64>,
+    submissions: std::cell::Cell<u64>,
 }
 
 /// What a GPU checkpoint adds to the f64 state: the exact device state, so that a GPU
@@ -301,6 +308,25 @@ impl GpuSimulation {
             ..Default::default()
         };
         law_params(law, &mut params);
+        // Every dispatch is one-dimensional: at most 65535 workgroups (issue 14 lifts it).
+        let widest = [
+            ceil_div(n_cap as u64, WG as u64),
+            ceil_div(cells.max(n_cap as u64), WG as u64),
+            ceil_div(table_cap, WG as u64),
+            blocks1 as u64,
+        ];
+        let most = widest.into_iter().max().unwrap_or(0);
+        if most > MAX_WORKGROUPS {
+            return Err(DeviceError::TooLarge {
+                name: gpu.info.name.clone(),
+                reason: format!(
+                    "{n_cap} particles and {cells} cells need {most} workgroups in one \
+                     dispatch and the GPU path issues at most {MAX_WORKGROUPS} (about \
+                     262 000 particles); use --backend cpu"
+                ),
+            }
+            .into());
+        }
 
         let check = |what: &str, bytes: u64| gpu.check_buffer(what, bytes);
         let n = n_cap as u64;
@@ -503,7 +529,15 @@ impl GpuSimulation {
             step,
             live: n_now,
             synced: true,
+            dispatches: Default::default(),
+            submissions: Default::default(),
         })
+    }
+
+    /// (dispatches, submissions) since the upload; a submission is a batch of steps or
+    /// a readback.
+    pub fn counters(&self) -> (u64, u64) {
+        (self.dispatches.get(), self.submissions.get())
     }
 
     pub fn adapter_name(&self) -> &str {
@@ -531,6 +565,7 @@ impl GpuSimulation {
     }
 
     fn dispatch(&self, pass: &mut wgpu::ComputePass, k: Kernel, groups: u64) {
+        self.dispatches.set(self.dispatches.get() + 1);
         pass.set_pipeline(&self.pipelines.pipelines[&k]);
         pass.dispatch_workgroups(groups.max(1) as u32, 1, 1);
     }
@@ -653,6 +688,7 @@ impl GpuSimulation {
                 }
             }
             self.gpu.queue.submit([enc.finish()]);
+            self.submissions.set(self.submissions.get() + 1);
             self.synced = false;
             let c = self.read_control();
             self.live = c[control::LIVE];
@@ -831,6 +867,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         enc.copy_buffer_to_buffer(buf, first as u64 * size, &staging, 0, bytes);
         self.gpu.queue.submit([enc.finish()]);
+        self.submissions.set(self.submissions.get() + 1);
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |r| r.expect("GPU readback failed"));
         self.gpu
