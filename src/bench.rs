@@ -240,6 +240,28 @@ pub fn run(
 ) -> Result<Report, String> {
     let mut results = Vec::new();
     let mut failures = Vec::new();
+    // `auto`: the GPU path on a hardware adapter; a software one (lavapipe) only when
+    // asked for by `gpu` (it would take minutes and measure the CPU twice).
+    let mut backends = backends.to_vec();
+    if backends.contains(&BackendChoice::Auto) {
+        let hardware = crate::gpu::device::choose_adapter()
+            .map(|a| a.get_info().device_type != wgpu::DeviceType::Cpu);
+        let gpu = match hardware {
+            Ok(true) => Some(BackendChoice::Gpu),
+            Ok(false) => {
+                log("no hardware GPU adapter: the GPU path is not measured (--backend gpu measures the software one)".into());
+                None
+            }
+            Err(e) => {
+                log(format!("the GPU path is not measured: {e}"));
+                None
+            }
+        };
+        backends.retain(|b| *b != BackendChoice::Auto);
+        if let Some(g) = gpu.filter(|g| !backends.contains(g)) {
+            backends.push(g);
+        }
+    }
     let mut workloads: Vec<(String, String)> = sizes
         .iter()
         .map(|&n| (format!("packing-{n}"), packing_scene(n)))
@@ -260,7 +282,7 @@ pub fn run(
     }
     for (name, text) in &workloads {
         let scene = scene::parse(text, &[]).map_err(|e| format!("{name}: {e}"))?;
-        for &b in backends {
+        for &b in &backends {
             let sim = Simulation::new(scene.clone()).map_err(|e| e.to_string())?;
             // The pour starts nearly empty: time ten times longer to see it fill.
             if name.ends_with("wide") && b == BackendChoice::Gpu {

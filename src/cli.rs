@@ -143,8 +143,9 @@ enum Command {
     },
     /// Measure particle-steps per second per backend and workload; prints JSON.
     Bench {
-        /// Backends to measure.
-        #[arg(long, value_enum, default_values_t = [Backend::Cpu, Backend::Gpu])]
+        /// Backends to measure (auto: the GPU path on a hardware adapter, none on a
+        /// software one; gpu: whatever adapter there is).
+        #[arg(long, value_enum, default_values_t = [Backend::Cpu, Backend::Auto])]
         backend: Vec<Backend>,
         /// Packing sizes (disks) of the settled-packing workloads.
         #[arg(long, value_delimiter = ',', default_values_t = [1000, 10000, 100000])]
@@ -154,10 +155,11 @@ enum Command {
         polygon_sizes: Vec<usize>,
         /// Steps timed per workload (after a warm-up of a tenth as many); with --budget,
         /// the most steps timed.
-        #[arg(long, default_value_t = 200)]
-        steps: u64,
+        #[arg(long)]
+        steps: Option<u64>,
         /// Seconds per workload and backend: time as many steps as fit (in doubling
-        /// batches, after a warm-up of 10 steps) instead of a fixed count.
+        /// batches, after a warm-up of 10 steps) instead of a fixed count. Default: 3 s,
+        /// unless --steps is given.
         #[arg(long)]
         budget: Option<f64>,
         /// Also time the reduced R4 pour.
@@ -780,11 +782,14 @@ fn choose_engine(sim: Simulation, backend: Backend, quiet: bool) -> Result<Engin
     }
 }
 
+/// Seconds per workload of a `talus bench` without --steps or --budget.
+const DEFAULT_BUDGET: f64 = 3.0;
+
 fn cmd_bench(
     backends: &[Backend],
     sizes: &[usize],
     polygon_sizes: &[usize],
-    steps: u64,
+    steps: Option<u64>,
     budget: Option<f64>,
     pour: bool,
     out: Option<PathBuf>,
@@ -795,6 +800,12 @@ fn cmd_bench(
             message: format!("--budget must be a positive number of seconds, got {b}"),
         });
     }
+    // A time budget per workload by default, so that the whole bench takes about a
+    // minute on any machine; a step count only when asked for.
+    let (steps, budget) = match (steps, budget) {
+        (Some(n), None) => (n, None),
+        (n, b) => (n.unwrap_or(100_000), Some(b.unwrap_or(DEFAULT_BUDGET))),
+    };
     let report = bench::run(
         backends,
         sizes,

@@ -341,3 +341,51 @@ fn bench_with_a_time_budget_reports_steps_and_microseconds() {
     }
     assert_rejected(&["bench", "--budget", "0"], &["--budget"]);
 }
+
+#[test]
+fn bench_measures_a_software_adapter_only_when_asked() {
+    // `auto` (the default with cpu) measures the GPU path on a hardware adapter only;
+    // lavapipe would take minutes and measure the CPU again.
+    let args = |backend: &str| {
+        vec![
+            "bench",
+            "--backend",
+            backend,
+            "--sizes",
+            "100",
+            "--polygon-sizes",
+            "10",
+            "--pour",
+            "false",
+            "--budget",
+            "0.1",
+        ]
+        .into_iter()
+        .map(String::from)
+        .collect::<Vec<_>>()
+    };
+    let a = args("auto");
+    let (code, stdout, err) = talus(&a.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let backends: Vec<&str> = v["results"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r["backend"].as_str().unwrap())
+        .collect();
+    if err.contains("no hardware GPU adapter") {
+        assert!(backends.is_empty(), "nothing measured: {backends:?}");
+    } else if backends.is_empty() {
+        assert!(err.contains("not measured"), "says why: {err}");
+    } else {
+        assert!(
+            backends.iter().all(|b| b.starts_with("gpu")),
+            "{backends:?}"
+        );
+        assert!(
+            !backends.iter().any(|b| b.contains("llvmpipe")),
+            "{backends:?}"
+        );
+    }
+}
