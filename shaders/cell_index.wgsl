@@ -3,12 +3,17 @@
 // counters of the later stages. Like every stage of the cell list, it runs only when
 // the neighbour lists are rebuilt (issue 13).
 
+// A grid-stride loop: the dispatch stops at 65535 workgroups, the cells and particles
+// may not.
 @compute @workgroup_size(WG)
-fn clear_cells(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let c = gid.x;
+fn clear_cells(@builtin(global_invocation_id) gid: vec3<u32>,
+               @builtin(num_workgroups) groups: vec3<u32>) {
     if (!rebuilding()) { return; }
-    if (c < params.cells) { atomicStore(&cell_count[c], 0u); }
-    if (c < params.n_cap) { atomicStore(&down_count[c], 0u); }
+    let stride = groups.x * WG;
+    for (var c = gid.x; c < max(params.cells, params.n_cap); c += stride) {
+        if (c < params.cells) { atomicStore(&cell_count[c], 0u); }
+        if (c < params.n_cap) { atomicStore(&down_count[c], 0u); }
+    }
 }
 
 @compute @workgroup_size(WG)

@@ -9,10 +9,15 @@ fn storing() -> bool {
     return (w & (REBUILD | FLUSH)) != 0u && (w & TABLE_CURRENT) == 0u;
 }
 
+// A grid-stride loop: the table has 8 slots per particle, more than 65535 workgroups
+// cover beyond 262 144 particles.
 @compute @workgroup_size(WG)
-fn clear_table(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let s = gid.x;
-    if (s <= params.table_mask && storing()) { atomicStore(&table[s].i, EMPTY); }
+fn clear_table(@builtin(global_invocation_id) gid: vec3<u32>,
+               @builtin(num_workgroups) groups: vec3<u32>) {
+    if (!storing()) { return; }
+    for (var s = gid.x; s <= params.table_mask; s += groups.x * WG) {
+        atomicStore(&table[s].i, EMPTY);
+    }
 }
 
 fn insert(i: u32, j: u32, value: f32) {

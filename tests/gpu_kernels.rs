@@ -1025,3 +1025,46 @@ fn degenerate_polygon_contacts_vary_continuously_on_the_gpu() {
         assert!(diff < 1e-3, "{name}: GPU and CPU differ by {diff:.2e}");
     }
 }
+
+#[test]
+fn clears_cover_everything_from_any_number_of_workgroups() {
+    // One dispatch holds at most 65535 workgroups; the clears of the cells and of the
+    // spring table loop over the rest (grid-stride), here from a single workgroup.
+    let Some(mut g) = setup(
+        "clears_cover_everything_from_any_number_of_workgroups",
+        &random_scene(300, spring_dashpot(), 8),
+    ) else {
+        return;
+    };
+    let cells = g.params.cells as usize;
+    assert!(
+        cells > 64 && g.params.table_mask as usize + 1 > 64,
+        "more than one workgroup's worth"
+    );
+    g.upload_cell_counts(&vec![7; cells]);
+    g.set_list_flags(REBUILD);
+    g.run_kernel_with_groups(Kernel::ClearCells, 1);
+    assert!(
+        g.read_u32("cell_count", cells).iter().all(|&c| c == 0),
+        "every cell cleared"
+    );
+    // A table full of springs, cleared by one workgroup.
+    let entries: Vec<Entry> = (0..200u32)
+        .map(|k| Entry {
+            i: k,
+            j: k + 1,
+            value: 1.0,
+            _pad: 0,
+        })
+        .collect();
+    g.upload_springs(&entries);
+    g.set_list_flags(REBUILD);
+    let slots = g.params.table_mask as usize + 1;
+    let keys = |g: &GpuSimulation| -> usize {
+        let words = g.read_u32("table", 4 * slots);
+        words.chunks(4).filter(|e| e[0] != u32::MAX).count()
+    };
+    assert_eq!(keys(&g), entries.len(), "the springs are in");
+    g.run_kernel_with_groups(Kernel::ClearTable, 1);
+    assert_eq!(keys(&g), 0, "every slot of the table cleared");
+}

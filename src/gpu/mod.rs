@@ -308,21 +308,18 @@ impl GpuSimulation {
             ..Default::default()
         };
         law_params(law, &mut params);
-        // Every dispatch is one-dimensional: at most 65535 workgroups (issue 14 lifts it).
-        let widest = [
-            ceil_div(n_cap as u64, WG as u64),
-            ceil_div(cells.max(n_cap as u64), WG as u64),
-            ceil_div(table_cap, WG as u64),
-            blocks1 as u64,
-        ];
+        // Every dispatch is one-dimensional: at most 65535 workgroups. The clears of the
+        // cells and of the spring table loop over what one dispatch does not cover; the
+        // per-particle stages take one thread per particle.
+        let widest = [ceil_div(n_cap as u64, WG as u64), blocks1 as u64];
         let most = widest.into_iter().max().unwrap_or(0);
         if most > MAX_WORKGROUPS {
             return Err(DeviceError::TooLarge {
                 name: gpu.info.name.clone(),
                 reason: format!(
-                    "{n_cap} particles and {cells} cells need {most} workgroups in one \
-                     dispatch and the GPU path issues at most {MAX_WORKGROUPS} (about \
-                     262 000 particles); use --backend cpu"
+                    "{n_cap} particles need {most} workgroups in one dispatch and the GPU \
+                     path issues at most {MAX_WORKGROUPS} (about 4.19 million particles); \
+                     use --backend cpu"
                 ),
             }
             .into());
@@ -579,14 +576,31 @@ impl GpuSimulation {
         let p = &self.params;
         let groups = match k {
             Kernel::InsertPlace | Kernel::ScanLevel2 | Kernel::AdvanceClock => 1,
-            Kernel::ClearCells => ceil_div(p.cells.max(p.n_cap) as u64, WG as u64),
+            // Grid-stride loops: as many workgroups as one dispatch takes.
+            Kernel::ClearCells => {
+                ceil_div(p.cells.max(p.n_cap) as u64, WG as u64).min(MAX_WORKGROUPS)
+            }
             Kernel::ClearCursor => ceil_div(p.cells as u64, WG as u64),
             Kernel::ScanLevel0 | Kernel::ScanAdd0 => p.scan_blocks1 as u64,
             Kernel::ScanLevel1 | Kernel::ScanAdd1 => p.scan_blocks2 as u64,
-            Kernel::ClearTable => ceil_div(p.table_mask as u64 + 1, WG as u64),
+            Kernel::ClearTable => ceil_div(p.table_mask as u64 + 1, WG as u64).min(MAX_WORKGROUPS),
             _ => self.per_particle(),
         };
         self.dispatch(pass, k, groups);
+    }
+
+    /// Runs one kernel with a given number of workgroups (tests of the grid-stride
+    /// loops, which must cover everything from any number of workgroups).
+    pub fn run_kernel_with_groups(&mut self, k: Kernel, groups: u64) {
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &self.group0, &[]);
+            pass.set_bind_group(1, &self.group1, &[]);
+            self.dispatch(&mut pass, k, groups);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.synced = false;
     }
 
     /// Runs some kernels once, in order, in one submission (tests of single stages).
@@ -1062,6 +1076,7 @@ impl GpuSimulation {
             "contact_j" => &b.contact_j,
             "contact_count" => &b.contact_count,
             "touching" => &b.touching,
+            "table" => &b.table,
             "control" => &b.control,
             _ => panic!("unknown buffer {name}"),
         };
