@@ -77,9 +77,15 @@ impl NeighbourList {
     /// than skin/2, since the rebuild. A position that is not finite has "moved".
     #[inline]
     pub fn moved(&self, particles: &Particles, i: usize) -> bool {
-        let (a, b) = (particles.q[0][i], self.at[i]);
+        self.moved_to(i, particles.q[0][i], particles.active[i])
+    }
+
+    /// `moved` for particle i now at `position`, active or not.
+    #[inline]
+    pub fn moved_to(&self, i: usize, position: Dof, active: bool) -> bool {
+        let (a, b) = (position, self.at[i]);
         let d2 = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
-        particles.active[i] != self.active[i] || d2.is_nan() || d2 > 0.25 * self.skin * self.skin
+        active != self.active[i] || d2.is_nan() || d2 > 0.25 * self.skin * self.skin
     }
 
     /// Lists the candidates of the current state and carries the history over: from

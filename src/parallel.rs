@@ -125,6 +125,46 @@ where
     }
 }
 
+/// f(k, [&mut v0[k], …, &mut v5[k]], &mut w[k]) for every k: a particle's six Gear
+/// values and one more value of it.
+pub fn for_each6_with<T, U, F>(v: &mut [Vec<T>; 6], w: &mut [U], f: F)
+where
+    T: Send,
+    U: Send,
+    F: Fn(usize, [&mut T; 6], &mut U) + Sync + Send,
+{
+    let [a, b, c, d, e, g] = v;
+    let n = a.len();
+    assert_eq!(w.len(), n);
+    if parallel(n) {
+        a.par_iter_mut()
+            .zip(b.par_iter_mut())
+            .zip(c.par_iter_mut())
+            .zip(d.par_iter_mut())
+            .zip(e.par_iter_mut())
+            .zip(g.par_iter_mut())
+            .zip(w.par_iter_mut())
+            .enumerate()
+            .with_min_len(chunk(n))
+            .for_each(|(k, ((((((q0, q1), q2), q3), q4), q5), x))| {
+                f(k, [q0, q1, q2, q3, q4, q5], x)
+            });
+    } else {
+        for (k, ((((((q0, q1), q2), q3), q4), q5), x)) in a
+            .iter_mut()
+            .zip(b.iter_mut())
+            .zip(c.iter_mut())
+            .zip(d.iter_mut())
+            .zip(e.iter_mut())
+            .zip(g.iter_mut())
+            .zip(w.iter_mut())
+            .enumerate()
+        {
+            f(k, [q0, q1, q2, q3, q4, q5], x);
+        }
+    }
+}
+
 /// The first k in 0..n for which f(k) holds (the same k whatever the thread count).
 pub fn position_first<F>(n: usize, f: F) -> Option<usize>
 where

@@ -216,17 +216,31 @@ impl Simulation {
     /// one's velocity q1/dt (what every contact reads), whether one has moved beyond the
     /// neighbour list's skin (returned), and the first whose position is not finite.
     fn survey(&mut self) -> bool {
-        let (p, list, dt) = (&self.particles, &self.neighbours, self.scene.dt);
-        let check_moves = !list.stale(p);
+        self.survey_with(false)
+    }
+
+    /// With `predict`, each particle is first predicted (Gear) in the same pass: one
+    /// read and write of the Gear values instead of two (bitwise the same as
+    /// `gear::predict` followed by `survey`).
+    fn survey_with(&mut self, predict: bool) -> bool {
+        let (list, dt) = (&self.neighbours, self.scene.dt);
+        let check_moves = !list.stale(&self.particles);
         let moved = AtomicBool::new(false);
         let lost = AtomicUsize::new(usize::MAX);
+        let p = &mut self.particles;
         self.velocity.resize(p.len(), [0.0; 3]);
-        crate::parallel::for_each(&mut self.velocity, |i, v| {
-            *v = p.velocity(i, dt);
-            if check_moves && list.moved(p, i) {
+        let (q, active, fixed) = (&mut p.q, &p.active, &p.fixed);
+        crate::parallel::for_each6_with(q, &mut self.velocity, |i, v, velocity| {
+            let [q0, q1, q2, q3, q4, q5] = v;
+            if predict && active[i] && !fixed[i] {
+                gear::predict_in_place([&mut *q0, &mut *q1, q2, q3, q4, q5]);
+            }
+            let (q0, q1) = (*q0, *q1);
+            *velocity = [q1[0] / dt, q1[1] / dt, q1[2] / dt];
+            if check_moves && list.moved_to(i, q0, active[i]) {
                 moved.store(true, Ordering::Relaxed);
             }
-            if p.active[i] && !p.q[0][i].iter().all(|v| v.is_finite()) {
+            if active[i] && !q0.iter().all(|v| v.is_finite()) {
                 lost.fetch_min(i, Ordering::Relaxed);
             }
         });
@@ -242,6 +256,11 @@ impl Simulation {
     /// not advance and keeps the springs as they were.
     pub fn evaluate_contacts(&mut self) {
         let moved = self.survey();
+        self.evaluate_surveyed(moved);
+    }
+
+    /// `evaluate_contacts` after the survey; `moved`: its answer.
+    fn evaluate_surveyed(&mut self, moved: bool) {
         if moved || self.neighbours.stale(&self.particles) {
             let d = &self.scene.domain;
             self.neighbours.rebuild(
@@ -333,10 +352,9 @@ impl Simulation {
         let t = self.time();
         self.insert_from_sources(t);
         let gear = self.scene.integrator == IntegratorKind::Gear5;
-        if gear {
-            gear::predict(&mut self.particles);
-        }
-        self.evaluate_contacts();
+        // Gear predicts each particle in the survey's pass.
+        let moved = self.survey_with(gear);
+        self.evaluate_surveyed(moved);
         self.check_divergence()?;
         // The candidates' updated springs become the list's.
         std::mem::swap(&mut self.neighbours.history, &mut self.candidates.history);

@@ -56,13 +56,19 @@ pub fn predict(p: &mut Particles) {
     let (q, active, fixed) = (&mut p.q, &p.active, &p.fixed);
     crate::parallel::for_each6(q, |i, v| {
         if active[i] && !fixed[i] {
-            let mut q = [*v[0], *v[1], *v[2], *v[3], *v[4], *v[5]];
-            predict_one(&mut q);
-            for (dst, src) in v.into_iter().zip(q) {
-                *dst = src;
-            }
+            predict_in_place(v);
         }
     });
+}
+
+/// `predict_one` on the six values of a particle where they are stored.
+#[inline(always)]
+pub fn predict_in_place(v: [&mut Dof; GEAR_VALUES]) {
+    let mut q = [*v[0], *v[1], *v[2], *v[3], *v[4], *v[5]];
+    predict_one(&mut q);
+    for (dst, src) in v.into_iter().zip(q) {
+        *dst = src;
+    }
 }
 
 /// Stage: correct every integrated particle with its force at the predicted state,
