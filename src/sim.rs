@@ -26,7 +26,7 @@ pub enum Divergence {
     #[error("particle {id} has a non-finite {what}")]
     NotFinite { id: u32, what: &'static str },
     #[error(
-        "particle {id} has more than {max} contacts (a GPU buffer limit; overlaps this large mean the run is diverging)"
+        "particle {id} has more than {max} neighbour-list candidates on the GPU path (pairs within the law's range plus the skin; a buffer limit): a smaller `skin` lists fewer, and if the overlaps are large the run is diverging"
     )]
     TooManyContacts { id: u32, max: u32 },
     #[error("the GPU spring table is full (particle {id})")]

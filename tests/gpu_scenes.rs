@@ -690,3 +690,39 @@ fn gpu_layered_runs_resume_bitwise() {
     // lies between two.
     assert_gpu_bitwise("gpu_layered_runs_resume_bitwise", layered_polygons, 2000);
 }
+
+#[test]
+fn too_many_candidates_stop_with_a_message_about_the_skin() {
+    // The GPU path's lists hold 16 candidates per particle as the lower id. A disk of
+    // diameter 4 (id 0) in a hexagonal bed of unit disks: with the default skin (0.3 of
+    // the largest diameter, 1.2) some 30 disks lie within range + skin of it, so the
+    // first rebuild stops with a message naming the skin; with skin 0.05 it runs.
+    let mut list = vec![json!({ "position": [0.0, 0.0], "diameter": 4.0 })];
+    let h = 3f64.sqrt() / 2.0;
+    for r in -6i32..=6 {
+        for c in -6i32..=6 {
+            let x = c as f64 + if r % 2 != 0 { 0.5 } else { 0.0 };
+            let z = r as f64 * h;
+            if x.hypot(z) >= 2.52 {
+                list.push(json!({ "position": [x, z], "diameter": 1.0 }));
+            }
+        }
+    }
+    let v = common::scene_value(
+        json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 5.0, "k_t": 500.0, "gamma_t": 1.0, "mu": 0.5 }),
+        json!([{ "kind": "list", "material": "m", "particles": list }]),
+    );
+    let Some(mut g) = gpu_sim("too_many_candidates", common::parse(&v)) else {
+        return;
+    };
+    let e = g.advance(2).expect_err("more than 16 candidates");
+    let message = e.to_string();
+    assert!(
+        message.contains("candidates") && message.contains("skin"),
+        "names the candidates and the skin: {message}"
+    );
+    let mut small = v.clone();
+    small["skin"] = json!(0.05);
+    let mut g = gpu_sim("too_many_candidates", common::parse(&small)).unwrap();
+    g.advance(20).expect("a smaller skin lists fewer");
+}
