@@ -98,31 +98,9 @@ where
     T: Send,
     F: Fn(usize, [&mut T; 6]) + Sync + Send,
 {
-    let [a, b, c, d, e, g] = v;
-    let n = a.len();
-    if parallel(n) {
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .zip(c.par_iter_mut())
-            .zip(d.par_iter_mut())
-            .zip(e.par_iter_mut())
-            .zip(g.par_iter_mut())
-            .enumerate()
-            .with_min_len(chunk(n))
-            .for_each(|(k, (((((q0, q1), q2), q3), q4), q5))| f(k, [q0, q1, q2, q3, q4, q5]));
-    } else {
-        for (k, (((((q0, q1), q2), q3), q4), q5)) in a
-            .iter_mut()
-            .zip(b.iter_mut())
-            .zip(c.iter_mut())
-            .zip(d.iter_mut())
-            .zip(e.iter_mut())
-            .zip(g.iter_mut())
-            .enumerate()
-        {
-            f(k, [q0, q1, q2, q3, q4, q5]);
-        }
-    }
+    // A slice of () takes no memory.
+    let mut none = vec![(); v[0].len()];
+    for_each6_with(v, &mut none, |k, q, _| f(k, q));
 }
 
 /// f(k, [&mut v0[k], …, &mut v5[k]], &mut w[k]) for every k: a particle's six Gear
