@@ -14,7 +14,7 @@ fn boundaries(@builtin(global_invocation_id) gid: vec3<u32>) {
         props[i].flags &= ~ACTIVE;
         atomicAdd(&control[C_LOST], 1u);
         // Its candidates leave the lists at the next step (as on the CPU path).
-        request_rebuild();
+        atomicOr(&control[C_LISTS], REMOVED);
     }
 }
 
@@ -22,8 +22,10 @@ fn boundaries(@builtin(global_invocation_id) gid: vec3<u32>) {
 fn advance_clock() {
     if (!halted()) {
         atomicAdd(&control[C_STEP], 1u);
-        // The lists are current; what the next step needs is asked for again.
+        // The lists are current; what the next step needs is asked for again, but a
+        // removal at the end of this one already asks for a rebuild.
         if (rebuilding()) { atomicAdd(&control[C_REBUILDS], 1u); }
-        atomicStore(&control[C_LISTS], 0u);
+        let removed = (lists_word() & REMOVED) != 0u;
+        atomicStore(&control[C_LISTS], select(0u, REBUILD, removed));
     }
 }

@@ -33,10 +33,12 @@ const C_BLOCKED: u32 = 8u;
 // than skin/2, or was inserted or removed, or the state was uploaded); TABLE_CURRENT,
 // the spring table holds the springs (an upload: the first rebuild takes them from it
 // instead of storing the lists' into it); FLUSH, the host asks for the table of the
-// current lists (`GpuSimulation::device_state`).
+// current lists (`GpuSimulation::device_state`); REMOVED, see below.
 const REBUILD: u32 = 1u;
 const TABLE_CURRENT: u32 = 2u;
 const FLUSH: u32 = 4u;
+// A particle was removed at the end of this step: the next step rebuilds the lists.
+const REMOVED: u32 = 8u;
 // Halt reasons (bits of control[C_HALT]).
 const HALT_OVERLAP: u32 = 1u;
 const HALT_NOT_FINITE: u32 = 2u;

@@ -726,3 +726,30 @@ fn too_many_candidates_stop_with_a_message_about_the_skin() {
     let mut g = gpu_sim("too_many_candidates", common::parse(&small)).unwrap();
     g.advance(20).expect("a smaller skin lists fewer");
 }
+
+#[test]
+fn a_particle_leaving_the_domain_leaves_the_gpu_lists() {
+    // As on the CPU path, a removal rebuilds the lists at the next step (the removal
+    // happens at the end of a step, after the step's own rebuild decision). A disk
+    // drifts out through the right edge by 0.3 d, far less than half the skin (2.5 d).
+    let list = json!([
+        { "position": [9.8, 0.0], "velocity": [2.0, 0.0], "diameter": 1.0 },
+        { "position": [0.0, 0.0], "diameter": 1.0 }
+    ]);
+    let mut v = common::scene_value(
+        json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 5.0, "k_t": 500.0, "gamma_t": 1.0, "mu": 0.5 }),
+        json!([{ "kind": "list", "material": "m", "particles": list }]),
+    );
+    v["domain"] = json!({ "x": [-10.0, 10.0], "z": [-10.0, 10.0] });
+    v["skin"] = json!(5.0);
+    v["dt"] = json!(1e-3);
+    let Some(mut g) = gpu_sim("a_particle_leaving_the_domain", common::parse(&v)) else {
+        return;
+    };
+    g.advance(10).unwrap();
+    assert_eq!(g.rebuilds(), 1, "built once, at the first step");
+    // x = 9.8 + 2 t: out at t = 0.1 (step 100); the next step rebuilds.
+    g.advance(140).unwrap();
+    assert_eq!(g.download().particles.active_count(), 1, "the disk left");
+    assert_eq!(g.rebuilds(), 2, "rebuilt once after the removal");
+}

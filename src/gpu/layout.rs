@@ -30,6 +30,7 @@ pub mod control {
     pub const REBUILD: u32 = 1;
     pub const TABLE_CURRENT: u32 = 2;
     pub const FLUSH: u32 = 4;
+    pub const REMOVED: u32 = 8;
     /// How many times the device built the lists (`C_REBUILDS`).
     pub const REBUILDS: usize = 7;
     pub const BLOCKED: usize = 8;
