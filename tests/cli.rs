@@ -179,7 +179,7 @@ fn gpu_backend_runs_the_default_scene_and_info_lists_adapters() {
     let (code, out, err) = talus(&["info"]);
     assert_eq!(code, 0, "{err}");
     assert!(
-        out.contains("GPU adapters (Vulkan)") && out.contains("--backend auto"),
+        out.contains("GPU adapters (Vulkan, Metal, DX12)") && out.contains("--backend auto"),
         "{out}"
     );
     let has_gpu = !out.contains("none found");

@@ -1,8 +1,9 @@
 //! Adapter discovery and device creation (issue 3, SPEC 7 `talus info`).
 //!
-//! talus uses only wgpu's Vulkan backend: it is what lavapipe (Mesa's software driver,
-//! used in CI) and the NVIDIA/AMD/Intel drivers of our users' workstations share, so one
-//! backend is tested everywhere the code runs.
+//! talus uses wgpu's Vulkan backend (what lavapipe, Mesa's software driver used in CI,
+//! and the NVIDIA/AMD/Intel drivers of Linux workstations share: the tested one), and
+//! where they exist Metal (macOS) and DX12 (Windows without a Vulkan driver), compiled
+//! in on those systems only and not tested by this project's machines yet.
 
 use std::fmt::Write as _;
 
@@ -21,8 +22,9 @@ pub const STORAGE_BUFFERS_NEEDED: u32 = 22;
 #[derive(Debug, thiserror::Error)]
 pub enum DeviceError {
     #[error(
-        "no GPU adapter found (talus needs a Vulkan driver; on a machine without a GPU, \
-         install Mesa's software driver: apt-get install mesa-vulkan-drivers libvulkan1)"
+        "no GPU adapter found (talus needs a Vulkan, Metal or DX12 driver; on a Linux \
+         machine without a GPU, install Mesa's software driver: apt-get install \
+         mesa-vulkan-drivers libvulkan1)"
     )]
     NoAdapter,
     #[error("the GPU adapter {name} cannot run talus: {reason}")]
@@ -33,15 +35,20 @@ pub enum DeviceError {
     TooLarge { name: String, reason: String },
 }
 
+/// The backends talus asks wgpu for (each compiled in only where it applies).
+const BACKENDS: wgpu::Backends = wgpu::Backends::VULKAN
+    .union(wgpu::Backends::METAL)
+    .union(wgpu::Backends::DX12);
+
 fn instance() -> wgpu::Instance {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
-    desc.backends = wgpu::Backends::VULKAN;
+    desc.backends = BACKENDS;
     wgpu::Instance::new(desc)
 }
 
-/// All adapters of the Vulkan backend.
+/// All adapters of those backends.
 pub fn adapters() -> Vec<wgpu::Adapter> {
-    pollster::block_on(instance().enumerate_adapters(wgpu::Backends::VULKAN))
+    pollster::block_on(instance().enumerate_adapters(BACKENDS))
 }
 
 /// Why an adapter cannot be used, if it cannot.
@@ -159,9 +166,9 @@ pub fn describe() -> String {
     let mut s = String::new();
     let all = adapters();
     if all.is_empty() {
-        let _ = writeln!(s, "GPU adapters (Vulkan): none found");
+        let _ = writeln!(s, "GPU adapters (Vulkan, Metal, DX12): none found");
     } else {
-        let _ = writeln!(s, "GPU adapters (Vulkan):");
+        let _ = writeln!(s, "GPU adapters (Vulkan, Metal, DX12):");
     }
     for a in &all {
         let i = a.get_info();
