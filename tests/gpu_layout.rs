@@ -73,10 +73,86 @@ fn rust_layouts_match_wgsl() {
     assert_eq!(checked, 8);
 }
 
+/// Every `const` of the assembled WGSL modules with a literal value, by name.
+fn wgsl_constants() -> std::collections::BTreeMap<String, f64> {
+    let mut out = std::collections::BTreeMap::new();
+    for m in MODULES {
+        let module = parse(m.name, &m.source());
+        for (_, c) in module.constants.iter() {
+            let Some(name) = c.name.clone() else { continue };
+            let value = match module.global_expressions[c.init] {
+                naga::Expression::Literal(naga::Literal::U32(v)) => v as f64,
+                naga::Expression::Literal(naga::Literal::I32(v)) => v as f64,
+                naga::Expression::Literal(naga::Literal::F32(v)) => v as f64,
+                naga::Expression::Literal(naga::Literal::AbstractInt(v)) => v as f64,
+                naga::Expression::Literal(naga::Literal::AbstractFloat(v)) => v,
+                _ => continue,
+            };
+            if let Some(old) = out.insert(name.clone(), value) {
+                assert_eq!(old, value, "{name} differs between modules");
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn shared_constants_are_the_same_in_rust_and_wgsl() {
+    // Constants typed in both languages (issue 14): a change on one side only fails
+    // here. (Changing MAX_CONTACTS in common.wgsl alone makes it fail.)
+    use layout::control as c;
+    let wgsl = wgsl_constants();
+    let rust: &[(&str, f64)] = &[
+        ("WG", layout::WG as f64),
+        ("SCAN_WG", layout::SCAN_WG as f64),
+        ("MAX_CONTACTS", layout::MAX_CONTACTS as f64),
+        ("WALL_BASE", talus::contacts::WALL_BASE as f64),
+        ("EMPTY", layout::EMPTY as f64),
+        ("ACTIVE", layout::ACTIVE as f64),
+        ("FIXED", layout::FIXED as f64),
+        ("INSERT_WINDOW", layout::INSERT_WINDOW as f64),
+        ("LAW_SPRING_DASHPOT", layout::LAW_SPRING_DASHPOT as f64),
+        ("LAW_CONTINUOUS", layout::LAW_CONTINUOUS as f64),
+        ("LAW_AREA", layout::LAW_AREA as f64),
+        ("C_STEP", c::STEP as f64),
+        ("C_LIVE", c::LIVE as f64),
+        ("C_LOST", c::LOST as f64),
+        ("C_HALT", c::HALT as f64),
+        ("C_HALT_STEP", c::HALT_STEP as f64),
+        ("C_HALT_ID", c::HALT_ID as f64),
+        ("C_LISTS", c::LISTS as f64),
+        ("C_REBUILDS", c::REBUILDS as f64),
+        ("C_BLOCKED", c::BLOCKED as f64),
+        ("REBUILD", c::REBUILD as f64),
+        ("TABLE_CURRENT", c::TABLE_CURRENT as f64),
+        ("FLUSH", c::FLUSH as f64),
+        ("REMOVED", c::REMOVED as f64),
+        ("HALT_OVERLAP", c::HALT_OVERLAP as f64),
+        ("HALT_NOT_FINITE", c::HALT_NOT_FINITE as f64),
+        ("HALT_CONTACTS_FULL", c::HALT_CONTACTS_FULL as f64),
+        ("HALT_TABLE_FULL", c::HALT_TABLE_FULL as f64),
+        ("MAX_CLIP", talus::overlap::MAX_CLIP as f64),
+        ("Q_LINE", talus::overlap::Q_LINE as f64),
+        ("WALL_LINE", talus::overlap::WALL_LINE as f64),
+        ("END_A_LINE", talus::overlap::END_A_LINE as f64),
+        ("END_B_LINE", talus::overlap::END_B_LINE as f64),
+    ];
+    for (name, value) in rust {
+        match wgsl.get(*name) {
+            Some(v) => assert_eq!(v, value, "{name}: WGSL {v}, Rust {value}"),
+            None => panic!("{name} is not a constant of the WGSL"),
+        }
+    }
+    // The polygon kernels' line ids and clip sizes follow from the corner limit.
+    assert_eq!(talus::overlap::Q_LINE, talus::shape::MAX_CORNERS);
+}
+
 #[test]
 fn host_and_wgsl_hash_agree_on_the_formula() {
-    // The WGSL hash_pair is the same expression; spot values pin the Rust twin.
-    assert_eq!(layout::hash_pair(0, 1), layout::hash_pair(0, 1));
+    // The WGSL hash_pair is the same expression: tests/gpu_kernels.rs builds spring
+    // tables with the Rust twin (`build_table`) and looks pairs up with the WGSL one
+    // (`gather_history`), which fails if they differ. Here: it is not symmetric, and it
+    // spreads neighbouring pairs over the table.
     assert_ne!(layout::hash_pair(1, 2), layout::hash_pair(2, 1));
     let mut seen = std::collections::HashSet::new();
     for i in 0..64 {

@@ -17,6 +17,11 @@ pub const WG: u32 = 64;
 /// Workgroup size of the prefix sum (`SCAN_WG`).
 pub const SCAN_WG: u32 = 256;
 
+/// `Params::law` (`LAW_*` in common.wgsl).
+pub const LAW_SPRING_DASHPOT: u32 = 0;
+pub const LAW_CONTINUOUS: u32 = 1;
+pub const LAW_AREA: u32 = 2;
+
 /// Words of the control buffer (`C_*` in common.wgsl).
 pub mod control {
     pub const STEP: usize = 0;

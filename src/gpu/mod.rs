@@ -1285,7 +1285,7 @@ pub fn table_lookup(table: &[Entry], i: u32, j: u32) -> Option<f32> {
 fn law_params(law: &ContactLaw, p: &mut Params) {
     match law {
         ContactLaw::SpringDashpot(l) => {
-            p.law = 0;
+            p.law = LAW_SPRING_DASHPOT;
             p.k_n = l.k_n as f32;
             p.nu = l.nu as f32;
             p.psi = l.psi as f32;
@@ -1298,7 +1298,7 @@ fn law_params(law: &ContactLaw, p: &mut Params) {
         }
         ContactLaw::OverlapArea(l) => {
             // η^n and η^t travel in gamma_n and gamma_t (common.wgsl).
-            p.law = 2;
+            p.law = LAW_AREA;
             p.k_n = l.k_n as f32;
             p.k_t = l.k_t as f32;
             p.mu = l.mu as f32;
@@ -1307,7 +1307,7 @@ fn law_params(law: &ContactLaw, p: &mut Params) {
             p.clamp = 1;
         }
         ContactLaw::Continuous(c) => {
-            p.law = 1;
+            p.law = LAW_CONTINUOUS;
             match c.elastic {
                 crate::law::continuous::Elastic::Power { n } => {
                     p.elastic = 0;
