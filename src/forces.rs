@@ -12,13 +12,14 @@ use crate::geometry::{
     Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent, wall_from,
 };
 use crate::law::{ContactInput, ContactLaw, ContactOutput, Law};
-use crate::neighbours::NeighbourList;
+use crate::neighbours::{NeighbourList, id_pair};
 use crate::overlap::{
     AreaContact, disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall,
 };
 use crate::shape::RotatedCorners;
+use crate::springs::pair_key;
 use crate::state::{Dof, Particles};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// The result of one contact, kept for outputs and the reduction.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -248,62 +249,52 @@ pub struct CandidateResults {
     pub history: Vec<f64>,
     /// Every candidate's contact, or None; empty when the step did not record.
     pub contacts: Vec<Option<ContactForce>>,
-    /// The first candidate whose contact diverges (`diverges`), with that contact.
+    /// The first candidate (by pair of ids) whose contact diverges (`diverges`), with
+    /// that contact.
     pub diverging: Option<(usize, ContactForce)>,
 }
 
 /// Stage: every candidate of the neighbour list evaluated on its own, in parallel, into
 /// `out`. The loop is specialised to the law. `record`: keep every whole contact too.
+/// `ids`: each memory slot's particle id.
 pub fn candidate_forces(
     s: &StepState,
     law: &ContactLaw,
     list: &NeighbourList,
+    ids: &[u32],
     max_overlap: f64,
     record: bool,
     out: &mut CandidateResults,
 ) {
+    let c = (list, ids, max_overlap, record);
     match law {
-        ContactLaw::SpringDashpot(l) => candidates_with(s, l, list, max_overlap, record, out),
-        ContactLaw::OverlapArea(l) => candidates_with(s, l, list, max_overlap, record, out),
-        ContactLaw::Continuous(l) => candidates_with(s, l, list, max_overlap, record, out),
+        ContactLaw::SpringDashpot(l) => candidates_with(s, l, c, out),
+        ContactLaw::OverlapArea(l) => candidates_with(s, l, c, out),
+        ContactLaw::Continuous(l) => candidates_with(s, l, c, out),
     }
 }
 
 fn candidates_with<L: Law>(
     s: &StepState,
     law: &L,
-    list: &NeighbourList,
-    max_overlap: f64,
-    record: bool,
+    (list, ids, max_overlap, record): (&NeighbourList, &[u32], f64, bool),
     out: &mut CandidateResults,
 ) {
     let n = list.pairs.len();
     out.kicks.resize(n, Kick::default());
     out.history.resize(n, 0.0);
     out.contacts.clear();
-    // The first diverging candidate: the smallest index, whichever thread finds it.
-    let first = AtomicUsize::new(usize::MAX);
+    // The first diverging candidate by pair of ids (the same whatever the memory order
+    // and whichever thread finds it).
+    let first = AtomicU64::new(u64::MAX);
+    let watch = Watch {
+        particles: s.particles,
+        ids,
+        max_overlap,
+        first: &first,
+    };
     let settle = |k: usize, r: Option<(ContactForce, f64)>, kick: &mut Kick, h: &mut f64| {
-        let pair = list.pairs[k];
-        match r {
-            Some((c, v)) => {
-                if diverges(s.particles, pair, &c, max_overlap) {
-                    first.fetch_min(k, Ordering::Relaxed);
-                }
-                *kick = Kick {
-                    force: c.force,
-                    torque: c.torque,
-                    contact: true,
-                };
-                *h = v;
-                Some(c)
-            }
-            None => {
-                kick.contact = false;
-                *h = 0.0;
-                None
-            }
-        }
+        settle(&watch, list.pairs[k], r, kick, h)
     };
     let evaluate = |k: usize, kick: &mut Kick, h: &mut f64| {
         let r = candidate_force(s, law, list.pairs[k], list.history[k]);
@@ -339,11 +330,62 @@ fn candidates_with<L: Law>(
             evaluate(k, kick, h);
         });
     }
-    let k = first.into_inner();
-    out.diverging = (k != usize::MAX).then(|| {
+    let key = first.into_inner();
+    out.diverging = (key != u64::MAX).then(|| {
+        let k = (list.pairs.iter())
+            .position(|&p| pair_key(id_pair(p, ids)) == key)
+            .expect("the diverging pair is a candidate");
         let c = candidate_force(s, law, list.pairs[k], list.history[k]);
         (k, c.expect("a diverging candidate is a contact").0)
     });
+}
+
+/// What `settle` needs to watch for a diverging contact.
+struct Watch<'a> {
+    particles: &'a Particles,
+    ids: &'a [u32],
+    max_overlap: f64,
+    /// The smallest key (by ids) of a diverging pair so far.
+    first: &'a AtomicU64,
+}
+
+/// One candidate's result into its kick and history slot (0 when not in contact); a
+/// diverging contact is noted. Returns the contact.
+#[inline(always)]
+fn settle(
+    w: &Watch,
+    pair: Pair,
+    r: Option<(ContactForce, f64)>,
+    kick: &mut Kick,
+    h: &mut f64,
+) -> Option<ContactForce> {
+    match r {
+        Some((c, v)) => {
+            if diverges(w.particles, pair, &c, w.max_overlap) {
+                note_diverging(w.first, pair, w.ids);
+            }
+            *kick = Kick {
+                force: c.force,
+                torque: c.torque,
+                contact: true,
+            };
+            *h = v;
+            Some(c)
+        }
+        None => {
+            kick.contact = false;
+            *h = 0.0;
+            None
+        }
+    }
+}
+
+/// Keeps the smaller of `first` and this diverging pair's key (by ids). Out of line:
+/// it is rare, and the candidate loop stays small enough to be inlined whole.
+#[cold]
+#[inline(never)]
+fn note_diverging(first: &AtomicU64, pair: Pair, ids: &[u32]) {
+    first.fetch_min(pair_key(id_pair(pair, ids)), Ordering::Relaxed);
 }
 
 /// r_i − r_j: the offset of the pair, the only way positions enter a contact's geometry

@@ -18,6 +18,15 @@
 //! slot (both lists are sorted by pair: one merge, no hashing), a new pair starts at 0.
 //! A list built for the first time takes the values from the spring table the state was
 //! created with (a checkpoint's).
+//!
+//! Memory order (issue 13 item 4): the particle arrays may be held in an order other
+//! than the ids' (`Simulation::advance` sorts them by cell at every rebuild, for
+//! locality). The list then works on memory slots, and `ids` gives each slot's particle
+//! id; everything that fixes an order goes by id: a pair's lower id is its i, a
+//! particle's candidates come by increasing partner id, the down lists by increasing
+//! partner id, the spring table is keyed by ids. Only the order of the particles' groups
+//! in `pairs` follows memory, and no sum depends on it, so results are bitwise the same
+//! in any memory order.
 
 use crate::cell_list::Grid;
 use crate::contacts::{Pair, WALL_BASE};
@@ -30,12 +39,13 @@ pub const DEFAULT_SKIN: f64 = 0.3;
 
 #[derive(Clone, Debug, Default)]
 pub struct NeighbourList {
-    /// Candidate pairs, sorted by (i, j); walls are j = WALL_BASE + w, after particles.
+    /// Candidate pairs of memory slots, grouped by i (the lower id) in slot order, each
+    /// group by increasing partner id; walls are j = WALL_BASE + w, after particles.
     pub pairs: Vec<Pair>,
-    /// Particle i's candidates (as the lower id) are `pairs[start[i]..start[i + 1]]`.
+    /// Slot i's candidates (as the lower id) are `pairs[start[i]..start[i + 1]]`.
     pub start: Vec<u32>,
-    /// Particle j's candidates as the higher id are the indices
-    /// `down[down_start[j]..down_start[j + 1]]` into `pairs`, in increasing i.
+    /// Slot j's candidates as the higher id are the indices
+    /// `down[down_start[j]..down_start[j + 1]]` into `pairs`, by increasing partner id.
     pub down_start: Vec<u32>,
     pub down: Vec<u32>,
     /// Each candidate's tangential history after the last completed step (0: no contact).
@@ -47,7 +57,7 @@ pub struct NeighbourList {
     /// particles sorted by cell (a sparse cell list: memory and time O(N), whatever the
     /// domain's area).
     grid: Option<Grid>,
-    cells: Vec<(u64, u32)>,
+    cells: Vec<Cell>,
     /// The skin of the last rebuild.
     pub skin: f64,
     /// How many times the list was built.
@@ -88,13 +98,24 @@ impl NeighbourList {
         active != self.active[i] || d2.is_nan() || d2 > 0.25 * self.skin * self.skin
     }
 
+    /// The grid of a rebuild for candidates within `reach`: the last one while its
+    /// cells are wide enough.
+    pub fn grid_for(&self, domain: ([f64; 2], [f64; 2]), reach: f64) -> Grid {
+        match &self.grid {
+            Some(g) if g.cell_size >= reach => g.clone(),
+            _ => Grid::new(domain.0, domain.1, reach),
+        }
+    }
+
     /// Lists the candidates of the current state and carries the history over: from
-    /// the old list's slots, or, the first time, from `table`.
+    /// the old list's slots, or, the first time, from `table`. `ids`: each memory
+    /// slot's particle id.
     #[allow(clippy::too_many_arguments)]
     pub fn rebuild(
         &mut self,
         domain: ([f64; 2], [f64; 2]),
         particles: &Particles,
+        ids: &[u32],
         walls: &[WallSegment],
         range_factor: f64,
         max_diameter: f64,
@@ -102,39 +123,29 @@ impl NeighbourList {
         table: &SpringTable,
     ) {
         let reach = range_factor * max_diameter + skin;
-        let grid = match &self.grid {
-            Some(g) if g.cell_size >= reach => g.clone(),
-            _ => Grid::new(domain.0, domain.1, reach),
-        };
-        sort_by_cell(&grid, particles, &mut self.cells);
+        let grid = self.grid_for(domain, reach);
+        sort_by_cell(&grid, particles, ids, &mut self.cells);
         let mut pairs = Vec::with_capacity(self.pairs.len().max(4 * particles.len()));
         let mut start = Vec::with_capacity(particles.len() + 1);
-        list_candidates(
-            &grid,
-            &self.cells,
+        let s = Search {
+            grid: &grid,
+            cells: &self.cells,
             particles,
+            ids,
             walls,
             range_factor,
             skin,
-            &mut pairs,
-            &mut start,
-        );
+        };
+        list_candidates(&s, &mut pairs, &mut start);
         let history = if self.is_built() {
-            carry_over(&self.pairs, &self.history, &pairs)
+            carry_over(&self.pairs, &self.history, &pairs, ids)
         } else {
             pairs
                 .iter()
-                .map(|&p| table.lookup(pair_key(p)).unwrap_or(0.0))
+                .map(|&p| table.lookup(pair_key(id_pair(p, ids))).unwrap_or(0.0))
                 .collect()
         };
-        self.down_start.clear();
-        self.down.clear();
-        down_lists(
-            &pairs,
-            particles.len(),
-            &mut self.down_start,
-            &mut self.down,
-        );
+        down_lists(&pairs, &start, ids, &mut self.down_start, &mut self.down);
         self.pairs = pairs;
         self.start = start;
         self.history = history;
@@ -146,18 +157,96 @@ impl NeighbourList {
     }
 
     /// The spring table of the last completed step: every candidate in contact then
-    /// (`in_contact`) with its history, inserted in list order (as `store_history`
-    /// built it).
-    pub fn table(&self, in_contact: &[bool]) -> SpringTable {
+    /// (`in_contact`) with its history, keyed by ids, inserted in list order (as
+    /// `store_history` built it).
+    pub fn table(&self, in_contact: &[bool], ids: &[u32]) -> SpringTable {
         let n = in_contact.iter().filter(|&&c| c).count();
         let mut t = SpringTable::with_capacity_for(n);
         for ((p, h), &c) in self.pairs.iter().zip(&self.history).zip(in_contact) {
             if c {
-                t.insert(pair_key(*p), *h);
+                t.insert(pair_key(id_pair(*p, ids)), *h);
             }
         }
         t
     }
+
+    /// Moves the list with its particles to a new memory order: `order[new] = old` slot,
+    /// `inverse[old] = new`, and `ids` the slots' ids in the new order. Each group keeps
+    /// its candidates (and their order, which goes by id); the groups follow their
+    /// particles. Returns, for each new candidate index, its old index, for the arrays
+    /// kept per candidate elsewhere. Particles inserted since the rebuild have no
+    /// candidates yet (the list is stale and is rebuilt before use).
+    pub fn permute(&mut self, order: &[u32], inverse: &[u32], ids: &[u32]) -> Vec<u32> {
+        if !self.is_built() {
+            return Vec::new();
+        }
+        let mut from = Vec::with_capacity(self.pairs.len());
+        let mut pairs = Vec::with_capacity(self.pairs.len());
+        let mut start = Vec::with_capacity(order.len() + 1);
+        let listed = self.start.len() - 1;
+        for (new, &old) in order.iter().enumerate() {
+            start.push(pairs.len() as u32);
+            let old = old as usize;
+            if old >= listed {
+                continue;
+            }
+            for k in self.start[old]..self.start[old + 1] {
+                let p = self.pairs[k as usize];
+                let j = if p.is_wall() {
+                    p.j
+                } else {
+                    inverse[p.j as usize]
+                };
+                pairs.push(Pair { i: new as u32, j });
+                from.push(k);
+            }
+        }
+        start.push(pairs.len() as u32);
+        self.history = gather(&self.history, &from);
+        down_lists(&pairs, &start, ids, &mut self.down_start, &mut self.down);
+        self.pairs = pairs;
+        self.start = start;
+        if self.at.len() == order.len() {
+            self.at = gather(&self.at, order);
+            self.active = gather(&self.active, order);
+        } else {
+            // Stale (`stale` stays true): the next use rebuilds.
+            self.at.clear();
+            self.active.clear();
+        }
+        from
+    }
+}
+
+/// `v` in a new order: `out[k] = v[from[k]]`.
+pub fn gather<T: Copy>(v: &[T], from: &[u32]) -> Vec<T> {
+    from.iter().map(|&k| v[k as usize]).collect()
+}
+
+/// A pair of memory slots as the pair of their ids (walls stay as they are).
+#[inline]
+pub fn id_pair(p: Pair, ids: &[u32]) -> Pair {
+    Pair {
+        i: ids[p.i as usize],
+        j: partner_key(p, ids),
+    }
+}
+
+/// The partner of a candidate in the order that sorts a group: its id, or the wall
+/// (walls after every particle).
+#[inline]
+fn partner_key(p: Pair, ids: &[u32]) -> u32 {
+    if p.is_wall() { p.j } else { ids[p.j as usize] }
+}
+
+/// The order that sorts the active particles by cell (by id within a cell), the
+/// inactive ones last (by slot): `order[new] = old` slot, for `Simulation::advance`.
+pub fn cell_order(grid: &Grid, particles: &Particles, ids: &[u32]) -> Vec<u32> {
+    let mut cells = Vec::new();
+    sort_by_cell(grid, particles, ids, &mut cells);
+    let mut order: Vec<u32> = cells.iter().map(|&(_, _, slot)| slot).collect();
+    order.extend((0..particles.len() as u32).filter(|&i| !particles.active[i as usize]));
+    order
 }
 
 /// A cell's key: its row, then its column (u64: a domain 10⁵ diameters square has 10¹⁰
@@ -166,51 +255,50 @@ fn cell_key(grid: &Grid, x: u32, z: u32) -> u64 {
     z as u64 * grid.nx as u64 + x as u64
 }
 
-/// Every active particle as (cell key, id), sorted: by cell, and by id within a cell.
-fn sort_by_cell(grid: &Grid, particles: &Particles, out: &mut Vec<(u64, u32)>) {
+/// Every active particle as (cell key, id, slot), sorted: by cell, and by id within a
+/// cell.
+fn sort_by_cell(grid: &Grid, particles: &Particles, ids: &[u32], out: &mut Vec<Cell>) {
     let q = &particles.q[0];
     out.clear();
     out.extend(
         crate::parallel::map(particles.len(), |i| {
             let (x, z) = grid.cell_coords([q[i][0], q[i][1]]);
-            (cell_key(grid, x, z), i as u32)
+            (cell_key(grid, x, z), ids[i], i as u32)
         })
         .into_iter()
-        .filter(|&(_, i)| particles.active[i as usize]),
+        .filter(|&(_, _, i)| particles.active[i as usize]),
     );
     crate::parallel::sort_unstable(out);
 }
 
+/// A particle of the sparse cell list: (cell key, id, memory slot).
+type Cell = (u64, u32, u32);
+
 /// The particles of the cells x0..=x1 of row z: one run of the sorted list.
-fn row_of_cells<'a>(
-    grid: &Grid,
-    cells: &'a [(u64, u32)],
-    x0: u32,
-    x1: u32,
-    z: u32,
-) -> &'a [(u64, u32)] {
+fn row_of_cells<'a>(grid: &Grid, cells: &'a [Cell], x0: u32, x1: u32, z: u32) -> &'a [Cell] {
     let (lo, hi) = (cell_key(grid, x0, z), cell_key(grid, x1, z));
     let a = cells.partition_point(|c| c.0 < lo);
     let b = a + cells[a..].partition_point(|c| c.0 <= hi);
     &cells[a..b]
 }
 
-/// The candidates of every active particle, in contact order, and where each particle's
-/// start (each particle's found on its own, on every thread).
-#[allow(clippy::too_many_arguments)]
-fn list_candidates(
-    grid: &Grid,
-    cells: &[(u64, u32)],
-    particles: &Particles,
-    walls: &[WallSegment],
+/// What a rebuild searches: the sparse cell list over the particles, and the walls.
+struct Search<'a> {
+    grid: &'a Grid,
+    cells: &'a [Cell],
+    particles: &'a Particles,
+    ids: &'a [u32],
+    walls: &'a [WallSegment],
     range_factor: f64,
     skin: f64,
-    out: &mut Vec<Pair>,
-    start: &mut Vec<u32>,
-) {
-    let lists = crate::parallel::map(particles.len(), |i| {
+}
+
+/// The candidates of every active particle, in contact order, and where each particle's
+/// start (each particle's found on its own, on every thread).
+fn list_candidates(s: &Search, out: &mut Vec<Pair>, start: &mut Vec<u32>) {
+    let lists = crate::parallel::map(s.particles.len(), |i| {
         let mut v = Vec::new();
-        candidates_of(grid, cells, particles, walls, range_factor, skin, i, &mut v);
+        candidates_of(s, i, &mut v);
         v
     });
     for v in lists {
@@ -220,20 +308,11 @@ fn list_candidates(
     start.push(out.len() as u32);
 }
 
-/// Particle i's candidates in contact order: partners j > i within range + skin by
-/// increasing j, then the walls. A pair of two fixed particles is never a candidate
+/// Slot i's candidates in contact order: partners of higher id within range + skin by
+/// increasing id, then the walls. A pair of two fixed particles is never a candidate
 /// (neither moves); an inactive particle has none.
-#[allow(clippy::too_many_arguments)]
-fn candidates_of(
-    grid: &Grid,
-    cells: &[(u64, u32)],
-    particles: &Particles,
-    walls: &[WallSegment],
-    range_factor: f64,
-    skin: f64,
-    i: usize,
-    out: &mut Vec<Pair>,
-) {
+fn candidates_of(s: &Search, i: usize, out: &mut Vec<Pair>) {
+    let (particles, grid, skin) = (s.particles, s.grid, s.skin);
     if !particles.active[i] {
         return;
     }
@@ -241,28 +320,30 @@ fn candidates_of(
     let pi = [pos[i][0], pos[i][1]];
     let (cx, cz) = grid.cell_coords(pi);
     let (x0, x1) = (cx.saturating_sub(1), (cx + 1).min(grid.nx - 1));
+    let mut found: Vec<(u32, u32)> = Vec::new();
     for z in cz.saturating_sub(1)..=(cz + 1).min(grid.nz - 1) {
         // The three cells x0..=x1 of a row are one run of the sorted list.
-        for &(_, j) in row_of_cells(grid, cells, x0, x1, z) {
+        for &(_, id, j) in row_of_cells(grid, s.cells, x0, x1, z) {
             let ju = j as usize;
-            if ju <= i || (particles.fixed[i] && particles.fixed[ju]) {
+            if id <= s.ids[i] || (particles.fixed[i] && particles.fixed[ju]) {
                 continue;
             }
             let (dx, dz) = (pos[ju][0] - pi[0], pos[ju][1] - pi[1]);
-            let reach = range_factor * (particles.radius[i] + particles.radius[ju]) + skin;
+            let reach = s.range_factor * (particles.radius[i] + particles.radius[ju]) + skin;
             // A NaN distance (a diverged state) is no candidate.
             if dx * dx + dz * dz < reach * reach {
-                out.push(Pair { i: i as u32, j });
+                found.push((id, j));
             }
         }
     }
-    out.sort_unstable();
+    found.sort_unstable();
+    out.extend(found.into_iter().map(|(_, j)| Pair { i: i as u32, j }));
     if particles.fixed[i] {
         return;
     }
-    for (w, wall) in walls.iter().enumerate() {
+    for (w, wall) in s.walls.iter().enumerate() {
         let g = disk_wall(particles.radius[i], &wall_from(wall, pi));
-        if 0.5 * g.r < range_factor * particles.radius[i] + skin {
+        if 0.5 * g.r < s.range_factor * particles.radius[i] + skin {
             out.push(Pair {
                 i: i as u32,
                 j: WALL_BASE + w as u32,
@@ -271,13 +352,15 @@ fn candidates_of(
     }
 }
 
-/// Each new candidate's history from the old list: both are sorted by pair, so one
-/// merge finds every pair that stays a candidate; a new pair starts at 0.
-fn carry_over(old: &[Pair], values: &[f64], new: &[Pair]) -> Vec<f64> {
+/// Each new candidate's history from the old list: both are in the same memory order
+/// and sorted by (slot of i, partner id), so one merge finds every pair that stays a
+/// candidate; a new pair starts at 0.
+fn carry_over(old: &[Pair], values: &[f64], new: &[Pair], ids: &[u32]) -> Vec<f64> {
+    let key = |p: &Pair| (p.i, partner_key(*p, ids));
     let mut out = Vec::with_capacity(new.len());
     let mut k = 0;
     for p in new {
-        while k < old.len() && old[k] < *p {
+        while k < old.len() && key(&old[k]) < key(p) {
             k += 1;
         }
         out.push(if k < old.len() && old[k] == *p {
@@ -289,9 +372,18 @@ fn carry_over(old: &[Pair], values: &[f64], new: &[Pair]) -> Vec<f64> {
     out
 }
 
-/// For each particle the candidates in which it is the higher id (j), by increasing i:
-/// a counting sort of the candidate indices by j, stable in list order.
-fn down_lists(pairs: &[Pair], n: usize, start: &mut Vec<u32>, down: &mut Vec<u32>) {
+/// For each slot the candidates in which it is the higher id (j), by increasing partner
+/// id: a counting sort of the candidate indices by j, stable, over the groups (`groups`:
+/// each slot's first candidate, as `NeighbourList::start`) taken in id order.
+fn down_lists(
+    pairs: &[Pair],
+    groups: &[u32],
+    ids: &[u32],
+    start: &mut Vec<u32>,
+    down: &mut Vec<u32>,
+) {
+    let n = groups.len() - 1;
+    start.clear();
     start.resize(n + 1, 0);
     for p in pairs.iter().filter(|p| !p.is_wall()) {
         start[p.j as usize + 1] += 1;
@@ -299,13 +391,22 @@ fn down_lists(pairs: &[Pair], n: usize, start: &mut Vec<u32>, down: &mut Vec<u32
     for k in 0..n {
         start[k + 1] += start[k];
     }
+    down.clear();
     down.resize(start[n] as usize, 0);
     let mut next = start[..n].to_vec();
-    for (k, p) in pairs.iter().enumerate() {
-        if !p.is_wall() {
-            let slot = &mut next[p.j as usize];
-            down[*slot as usize] = k as u32;
-            *slot += 1;
+    let mut by_id = vec![0u32; n];
+    for (slot, &id) in ids.iter().enumerate() {
+        by_id[id as usize] = slot as u32;
+    }
+    for &i in &by_id {
+        let i = i as usize;
+        for k in groups[i]..groups[i + 1] {
+            let p = pairs[k as usize];
+            if !p.is_wall() {
+                let slot = &mut next[p.j as usize];
+                down[*slot as usize] = k;
+                *slot += 1;
+            }
         }
     }
 }
@@ -329,8 +430,9 @@ mod tests {
             pair(2, 3),
             pair(2, WALL_BASE),
         ];
+        let ids = [0, 1, 2, 3, 4];
         assert_eq!(
-            carry_over(&old, &values, &new),
+            carry_over(&old, &values, &new, &ids),
             vec![2.0, 0.0, 3.0, 0.0, 4.0]
         );
     }
@@ -344,9 +446,28 @@ mod tests {
             pair(1, WALL_BASE),
             pair(2, 3),
         ];
+        let groups = [0, 2, 4, 5, 5];
         let (mut start, mut down) = (Vec::new(), Vec::new());
-        down_lists(&pairs, 4, &mut start, &mut down);
+        down_lists(&pairs, &groups, &[0, 1, 2, 3], &mut start, &mut down);
         assert_eq!(start, vec![0, 0, 0, 2, 4]);
         assert_eq!(down, vec![0, 2, 1, 4]);
+    }
+
+    #[test]
+    fn down_lists_follow_ids_not_memory() {
+        // Slots 0, 1, 2 hold ids 2, 0, 1: the pairs (id 0, id 2) = slots (1, 0) and
+        // (id 1, id 2) = slots (2, 0) are both in slot 0's down list, id 0's first.
+        let ids = [2, 0, 1];
+        let pairs = [pair(1, 0), pair(2, 0)];
+        let groups = [0, 0, 1, 2];
+        let (mut start, mut down) = (Vec::new(), Vec::new());
+        down_lists(&pairs, &groups, &ids, &mut start, &mut down);
+        assert_eq!(down, vec![0, 1]);
+        // Slots 1 and 2 holding ids 1 and 0: memory puts (id 1, id 2) first, the down
+        // list still (id 0, id 2).
+        let ids = [2, 1, 0];
+        let groups = [0, 0, 1, 2];
+        down_lists(&pairs, &groups, &ids, &mut start, &mut down);
+        assert_eq!(down, vec![1, 0]);
     }
 }

@@ -129,15 +129,7 @@ impl Engine {
 
     pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
         match self {
-            // Only the last step's contacts can be looked at.
-            Self::Cpu(s) => {
-                let done = (0..steps).try_for_each(|k| {
-                    s.record_contacts = k + 1 == steps;
-                    s.step()
-                });
-                s.record_contacts = true;
-                done
-            }
+            Self::Cpu(s) => s.advance(steps),
             Self::Gpu(g) => g.advance(steps),
         }
     }

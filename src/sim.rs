@@ -12,7 +12,7 @@ use crate::forces::{
 use crate::geometry::WallSegment;
 use crate::integrate::{gear, leapfrog};
 use crate::law::ContactLaw;
-use crate::neighbours::{DEFAULT_SKIN, NeighbourList};
+use crate::neighbours::{DEFAULT_SKIN, NeighbourList, cell_order, gather, id_pair};
 use crate::rng::Rng;
 use crate::scene::{Creation, IntegratorKind, Scene, SceneError};
 use crate::shape::{RotatedCorners, rotate_corners};
@@ -41,6 +41,10 @@ pub enum Divergence {
         limit: f64,
     },
 }
+
+/// The shortest `Simulation::advance` that sorts the particles in memory: sorting and
+/// putting back cost a few steps' time (measured: 1–3 steps at 10⁵ disks).
+pub const SORTED_ADVANCE: u64 = 64;
 
 /// Energies at the end of a step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -96,6 +100,19 @@ pub struct Simulation {
     lost_position: Option<usize>,
     /// Whether a step has moved the springs into the neighbour list.
     committed: bool,
+    /// Each memory slot's particle id. The identity, except inside `advance`, which
+    /// sorts the particles by cell at every rebuild (issue 13 item 4) and puts them back
+    /// in id order before it returns: outside it, index = id everywhere.
+    ids: Vec<u32>,
+    /// Whether a rebuild sorts the particles by cell (inside `advance`).
+    reorder: bool,
+    /// How many rebuilds have changed the particles' memory order.
+    pub reorders: u64,
+    /// The cell order of the last sort (each slot's id then) and the neighbour list
+    /// it was made for (its rebuild count): the next `advance` starts from it.
+    sorted: (Vec<u32>, u64),
+    /// Whether the next evaluation rebuilds the list whatever the motion.
+    force_rebuild: bool,
 }
 
 impl Simulation {
@@ -164,6 +181,11 @@ impl Simulation {
             velocity: Vec::new(),
             lost_position: None,
             committed: false,
+            ids: Vec::new(),
+            reorder: false,
+            reorders: 0,
+            sorted: (Vec::new(), 0),
+            force_rebuild: false,
         })
     }
 
@@ -229,7 +251,7 @@ impl Simulation {
         let lost = AtomicUsize::new(usize::MAX);
         let p = &mut self.particles;
         self.velocity.resize(p.len(), [0.0; 3]);
-        let (q, active, fixed) = (&mut p.q, &p.active, &p.fixed);
+        let (q, active, fixed, ids) = (&mut p.q, &p.active, &p.fixed, &self.ids);
         crate::parallel::for_each6_with(q, &mut self.velocity, |i, v, velocity| {
             let [q0, q1, q2, q3, q4, q5] = v;
             if predict && active[i] && !fixed[i] {
@@ -241,7 +263,7 @@ impl Simulation {
                 moved.store(true, Ordering::Relaxed);
             }
             if active[i] && !q0.iter().all(|v| v.is_finite()) {
-                lost.fetch_min(i, Ordering::Relaxed);
+                lost.fetch_min(ids[i] as usize, Ordering::Relaxed);
             }
         });
         let lost = lost.into_inner();
@@ -255,23 +277,50 @@ impl Simulation {
     /// step. Public for measurements and tests of the contacts of a given state; it does
     /// not advance and keeps the springs as they were.
     pub fn evaluate_contacts(&mut self) {
+        self.sync_ids();
         let moved = self.survey();
         self.evaluate_surveyed(moved);
     }
 
     /// `evaluate_contacts` after the survey; `moved`: its answer.
     fn evaluate_surveyed(&mut self, moved: bool) {
-        if moved || self.neighbours.stale(&self.particles) {
+        if moved || self.force_rebuild || self.neighbours.stale(&self.particles) {
+            self.force_rebuild = false;
             let d = &self.scene.domain;
+            let domain = (d.x, d.z);
+            if self.reorder {
+                let reach = self.law.range_factor() * self.largest_diameter() + self.skin();
+                let grid = self.neighbours.grid_for(domain, reach);
+                let order = cell_order(&grid, &self.particles, &self.ids);
+                if order
+                    .iter()
+                    .enumerate()
+                    .any(|(new, &old)| old as usize != new)
+                {
+                    self.permute(&order, false);
+                    self.reorders += 1;
+                }
+                self.sorted.0.clone_from(&self.ids);
+            }
+            // Springs from a table only for a list built for the first time.
+            let table = if self.neighbours.is_built() {
+                SpringTable::default()
+            } else {
+                self.spring_table()
+            };
             self.neighbours.rebuild(
-                (d.x, d.z),
+                domain,
                 &self.particles,
+                &self.ids,
                 &self.walls,
                 self.law.range_factor(),
                 self.largest_diameter(),
                 self.skin(),
-                &self.spring_table(),
+                &table,
             );
+            if self.reorder {
+                self.sorted.1 = self.neighbours.rebuilds;
+            }
         }
         rotate_corners(&self.particles, &mut self.corners);
         let state = StepState {
@@ -285,12 +334,18 @@ impl Simulation {
             &state,
             &self.law,
             &self.neighbours,
+            &self.ids,
             self.scene.limits.max_overlap,
             self.record_contacts,
             &mut self.candidates,
         );
-        // The contacts, in list order (by i, then j): what find_contacts lists. Only
-        // when someone will look (outputs between the steps of a run need none).
+        self.collect_contacts();
+    }
+
+    /// The contacts, in list order (in id order: by i, then j, what find_contacts
+    /// lists, once the particles are back in id order). Only when someone will look
+    /// (outputs between the steps of a run need none).
+    fn collect_contacts(&mut self) {
         self.pairs.clear();
         self.contacts.clear();
         if self.record_contacts {
@@ -302,6 +357,107 @@ impl Simulation {
         }
     }
 
+    /// Ids for particles added since the last step (in id order: appended), so that
+    /// `ids` covers every slot.
+    fn sync_ids(&mut self) {
+        let n = self.particles.len();
+        self.ids.truncate(n);
+        self.ids.extend(self.ids.len() as u32..n as u32);
+    }
+
+    /// Puts the particles, and everything kept per particle or per candidate, in a new
+    /// memory order: `order[new] = old` slot. No result depends on the order.
+    /// `results`: also the last evaluation's results per candidate (not needed at a
+    /// rebuild, which is followed by a new evaluation).
+    fn permute(&mut self, order: &[u32], results: bool) {
+        let mut inverse = vec![0u32; order.len()];
+        for (new, &old) in order.iter().enumerate() {
+            inverse[old as usize] = new as u32;
+        }
+        self.particles.permute(order);
+        // The corners are laid out by memory slot: again at the next rotation.
+        self.corners = RotatedCorners::default();
+        if self.velocity.len() == order.len() {
+            self.velocity = gather(&self.velocity, order);
+        }
+        self.ids = gather(&self.ids, order);
+        let from = self.neighbours.permute(order, &inverse, &self.ids);
+        let c = &mut self.candidates;
+        if !results {
+            c.kicks.clear();
+            c.history.clear();
+            c.contacts.clear();
+            c.diverging = None;
+        } else if c.kicks.len() == from.len() {
+            c.kicks = gather(&c.kicks, &from);
+            c.history = gather(&c.history, &from);
+        }
+        if c.contacts.len() == from.len() {
+            c.contacts = gather(&c.contacts, &from);
+        }
+        if let Some((k, _)) = &mut c.diverging {
+            *k = from.iter().position(|&f| f as usize == *k).unwrap_or(*k);
+        }
+        self.collect_contacts();
+    }
+
+    /// Runs `steps` steps; only the last one lists its contacts. Bitwise the same as as
+    /// many `step` calls. An advance of `SORTED_ADVANCE` steps or more runs all but its
+    /// last step with the particles sorted in memory by cell, sorted again at every
+    /// rebuild of the neighbour list (locality: a particle's partners lie next to it in
+    /// memory), and puts them back in id order for the last step (also after a
+    /// divergence), so that outside `advance` index = id.
+    pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
+        let mut done = Ok(());
+        let mut left = steps;
+        if steps >= SORTED_ADVANCE {
+            self.sort_by_cell();
+            self.reorder = true;
+            self.record_contacts = false;
+            done = (1..steps).try_for_each(|_| self.step());
+            self.reorder = false;
+            self.restore_id_order(done.is_err());
+            left = 1;
+        }
+        if done.is_ok() {
+            done = (0..left).try_for_each(|k| {
+                self.record_contacts = k + 1 == left;
+                self.step()
+            });
+        }
+        self.record_contacts = true;
+        done
+    }
+
+    /// Puts the particles in the cell order of the last sort, if it was made for the
+    /// current neighbour list; otherwise the next step rebuilds the list (and sorts).
+    fn sort_by_cell(&mut self) {
+        self.sync_ids();
+        let (order, list) = &self.sorted;
+        if *list == self.neighbours.rebuilds && order.len() == self.ids.len() {
+            // In id order the last sort's ids are the slots to take from.
+            let order = order.clone();
+            // The last step's results per candidate are not needed: the next step
+            // replaces them before anyone reads them.
+            self.permute(&order, false);
+        } else {
+            self.force_rebuild = true;
+        }
+    }
+
+    /// Puts the particles back in id order; `results`: with the last evaluation's
+    /// results per candidate (else the next evaluation must come first).
+    fn restore_id_order(&mut self, results: bool) {
+        if self.ids.iter().enumerate().all(|(k, &id)| id as usize == k) {
+            return;
+        }
+        let mut order = vec![0u32; self.ids.len()];
+        for (slot, &id) in self.ids.iter().enumerate() {
+            order[id as usize] = slot as u32;
+        }
+        self.permute(&order, results);
+    }
+
     /// The tangential springs of the last completed step as a table keyed by pair (for
     /// checkpoints and the GPU path): the contacts of that step with their springs.
     pub fn spring_table(&self) -> SpringTable {
@@ -309,7 +465,7 @@ impl Simulation {
             return self.springs.clone();
         }
         let in_contact: Vec<bool> = self.candidates.kicks.iter().map(|k| k.contact).collect();
-        self.neighbours.table(&in_contact)
+        self.neighbours.table(&in_contact, &self.ids)
     }
 
     /// Starts Gear with the true initial acceleration in q2, (F/m + g) dt²/2 from the
@@ -350,6 +506,7 @@ impl Simulation {
     pub fn step(&mut self) -> Result<(), Divergence> {
         let dt = self.scene.dt;
         let t = self.time();
+        self.sync_ids();
         self.insert_from_sources(t);
         let gear = self.scene.integrator == IntegratorKind::Gear5;
         // Gear predicts each particle in the survey's pass.
@@ -407,6 +564,8 @@ impl Simulation {
     fn push_new(&mut self, new: &mut Vec<create::NewParticle>, t: f64) {
         for d in new.drain(..) {
             let id = create::push(&self.scene, &mut self.particles, &d) as usize;
+            // Ids are never reused: the new one is the number of particles so far.
+            self.ids.push(self.ids.len() as u32);
             let h = 0.5 * self.scene.dt * self.scene.dt;
             if self.scene.integrator == IntegratorKind::Gear5 {
                 let g = self.gravity(t);
@@ -419,19 +578,20 @@ impl Simulation {
         let limit = self.scene.limits.max_overlap;
         if let Some((k, c)) = &self.candidates.diverging {
             let pair = self.neighbours.pairs[*k];
+            let ids = id_pair(pair, &self.ids);
             if !(c.force[0].is_finite() && c.force[1].is_finite()) {
                 return Err(Divergence::NotFinite {
-                    id: pair.i,
+                    id: ids.i,
                     what: "contact force",
                 });
             }
             let j = if pair.is_wall() {
                 format!("wall {}", pair.j - crate::contacts::WALL_BASE)
             } else {
-                pair.j.to_string()
+                ids.j.to_string()
             };
             return Err(Divergence::Overlap {
-                i: pair.i,
+                i: ids.i,
                 j,
                 ratio: overlap_ratio(&self.particles, pair, c),
                 limit,

@@ -115,6 +115,27 @@ impl Particles {
         !self.shape[i].is_empty()
     }
 
+    /// Puts the particles in a new memory order: `order[new] = old` index (a
+    /// permutation of 0..len).
+    pub fn permute(&mut self, order: &[u32]) {
+        use crate::neighbours::gather;
+        assert_eq!(order.len(), self.len());
+        for q in &mut self.q {
+            *q = gather(q, order);
+        }
+        self.radius = gather(&self.radius, order);
+        self.mass = gather(&self.mass, order);
+        self.inertia = gather(&self.inertia, order);
+        self.fixed = gather(&self.fixed, order);
+        self.active = gather(&self.active, order);
+        self.material = gather(&self.material, order);
+        let mut shape = std::mem::take(&mut self.shape);
+        self.shape = order
+            .iter()
+            .map(|&k| std::mem::take(&mut shape[k as usize]))
+            .collect();
+    }
+
     pub fn max_radius(&self) -> f64 {
         self.radius.iter().copied().fold(0.0, f64::max)
     }

@@ -128,9 +128,11 @@ fn neighbour_lists_hold_every_contact_until_a_particle_moves_half_the_skin() {
         let mut list = NeighbourList::default();
         let table = talus::springs::SpringTable::default();
         let max_d = 2.0 * p.max_radius();
+        let ids: Vec<u32> = (0..p.len() as u32).collect();
         list.rebuild(
             ([0.0, 30.0], [0.0, 20.0]),
             &p,
+            &ids,
             &walls,
             range,
             max_d,
@@ -180,4 +182,75 @@ fn neighbour_lists_hold_every_contact_until_a_particle_moves_half_the_skin() {
         checked >= 6 && moved_contacts > 2000,
         "{checked} packings, {moved_contacts} contacts"
     );
+}
+
+#[test]
+fn neighbour_lists_in_any_memory_order_hold_the_same_pairs_in_the_same_order() {
+    // Issue 13 item 4: particles held in another memory order (`ids`: each slot's id)
+    // give the same candidates, by id, each particle's in the same order (by partner
+    // id, walls last), and down lists by increasing partner id: what fixes the order of
+    // every force sum.
+    let walls = [WallSegment {
+        a: [0.0, 0.3],
+        b: [30.0, 0.3],
+    }];
+    let mut rng = Rng::new(4);
+    let mut compared = 0;
+    for seed in 0..6 {
+        let polygons = seed % 2 == 1;
+        let p = packing(200 + seed, 400, polygons);
+        let table = talus::springs::SpringTable::default();
+        let domain = ([0.0, 30.0], [0.0, 20.0]);
+        let build = |p: &Particles, ids: &[u32]| {
+            let mut list = NeighbourList::default();
+            list.rebuild(
+                domain,
+                p,
+                ids,
+                &walls,
+                1.0,
+                2.0 * p.max_radius(),
+                0.3,
+                &table,
+            );
+            list
+        };
+        let identity: Vec<u32> = (0..p.len() as u32).collect();
+        let plain = build(&p, &identity);
+        // A random memory order: order[new] = old slot (= id here).
+        let mut order = identity.clone();
+        for k in (1..order.len()).rev() {
+            order.swap(k, (rng.uniform() * (k + 1) as f64) as usize % (k + 1));
+        }
+        let mut shuffled = p.clone();
+        shuffled.permute(&order);
+        let list = build(&shuffled, &order);
+        for id in 0..p.len() {
+            let slot = order.iter().position(|&o| o as usize == id).unwrap();
+            let mine = |l: &NeighbourList, s: usize, ids: &[u32]| -> Vec<talus::contacts::Pair> {
+                l.pairs[l.start[s] as usize..l.start[s + 1] as usize]
+                    .iter()
+                    .map(|&q| talus::neighbours::id_pair(q, ids))
+                    .collect()
+            };
+            assert_eq!(
+                mine(&list, slot, &order),
+                mine(&plain, id, &identity),
+                "seed {seed}, id {id}"
+            );
+            let down: Vec<u32> = list.down
+                [list.down_start[slot] as usize..list.down_start[slot + 1] as usize]
+                .iter()
+                .map(|&k| order[list.pairs[k as usize].i as usize])
+                .collect();
+            let plain_down: Vec<u32> = plain.down
+                [plain.down_start[id] as usize..plain.down_start[id + 1] as usize]
+                .iter()
+                .map(|&k| plain.pairs[k as usize].i)
+                .collect();
+            assert_eq!(down, plain_down, "seed {seed}, id {id}: down list");
+            compared += plain_down.len();
+        }
+    }
+    assert!(compared > 3000, "{compared} pairs compared");
 }
