@@ -22,5 +22,5 @@ fn cell_index(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.n_cap || !rebuilding()) { return; }
     if (i >= live() || !is_active(i)) { cell_of[i] = EMPTY; return; }
     let c = cell_coords(state[i].anchor);
-    cell_of[i] = c.y * params.nx + c.x;
+    cell_of[i] = bucket(c);
 }

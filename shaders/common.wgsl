@@ -263,6 +263,33 @@ fn cell_coords(a: vec2<i32>) -> vec2<u32> {
     return vec2<u32>(u32(cx), u32(cz));
 }
 
+// Whether the grid is hashed into `params.cells` buckets (issue 13: a grid with more
+// cells than that, a wide domain, takes memory O(N) whatever its area) or dense
+// (nx nz <= cells: bucket = cell). Written without the product, which may overflow.
+fn hashed_grid() -> bool {
+    return params.nx > params.cells / params.nz;
+}
+
+// The spatial hash: the cell's coordinates times large primes (Teschner et al. 2003),
+// mixed by Wellons's lowbias32 so that every bit of the bucket depends on both.
+const HASH_X: u32 = 73856093u;
+const HASH_Z: u32 = 19349663u;
+const HASH_MIX_1: u32 = 0x7feb352du;
+const HASH_MIX_2: u32 = 0x846ca68bu;
+
+// The bucket of cell c (twin of `gpu::bucket`): the cell itself on a dense grid, else a
+// spatial hash; cells that share a bucket are told apart by their particles' anchors.
+fn bucket(c: vec2<u32>) -> u32 {
+    if (!hashed_grid()) { return c.y * params.nx + c.x; }
+    var h = (c.x * HASH_X) ^ (c.y * HASH_Z);
+    h ^= h >> 16u;
+    h *= HASH_MIX_1;
+    h ^= h >> 15u;
+    h *= HASH_MIX_2;
+    h ^= h >> 16u;
+    return h % params.cells;
+}
+
 fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
     return a.x * b.y - a.y * b.x;
 }

@@ -44,14 +44,18 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let z1 = min(c.y + 1u, params.nz - 1u);
     let x0 = max(i32(c.x) - 1, 0);
     let x1 = min(c.x + 1u, params.nx - 1u);
+    let hashed = hashed_grid();
     for (var z = u32(z0); z <= z1; z++) {
         for (var x = u32(x0); x <= x1; x++) {
-            let cell = z * params.nx + x;
+            let cell = bucket(vec2<u32>(x, z));
             let start = cell_start[cell];
             let end = start + atomicLoad(&cell_count[cell]);
             for (var s = start; s < end; s++) {
                 let j = sorted[s];
                 if (j <= i || (fixed_i && is_fixed(j))) { continue; }
+                // A bucket of a hashed grid may hold other cells too (and be visited
+                // for each of them): only this cell's particles count here.
+                if (hashed && any(cell_coords(state[j].anchor) != vec2<u32>(x, z))) { continue; }
                 if (!is_candidate(i, j)) { continue; }
                 if (n == MAX_CONTACTS) { halt(HALT_CONTACTS_FULL, i); break; }
                 // Insertion sort by j: the order must not depend on the cell layout.

@@ -136,6 +136,10 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("WALL_LINE", talus::overlap::WALL_LINE as f64),
         ("END_A_LINE", talus::overlap::END_A_LINE as f64),
         ("END_B_LINE", talus::overlap::END_B_LINE as f64),
+        ("HASH_X", talus::gpu::HASH_X as f64),
+        ("HASH_Z", talus::gpu::HASH_Z as f64),
+        ("HASH_MIX_1", talus::gpu::HASH_MIX_1 as f64),
+        ("HASH_MIX_2", talus::gpu::HASH_MIX_2 as f64),
     ];
     for (name, value) in rust {
         match wgsl.get(*name) {

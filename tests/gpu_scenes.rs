@@ -270,14 +270,38 @@ fn straight_column_error(sim: &Simulation, first: u32) -> f64 {
 
 #[test]
 fn overlaps_are_the_same_at_x_0_and_at_x_10000_diameters() {
+    assert_columns("overlaps_are_the_same_at_x_0_and_at_x_10000", None);
+}
+
+#[test]
+fn a_domain_a_hundred_thousand_diameters_square_runs_on_the_gpu() {
+    // Issue 13: a grid with more cells than the GPU holds (here 2.5 · 10⁹) is hashed into
+    // buckets, about two per particle; find_contacts tells the cells of a bucket apart.
+    // The columns give the same overlaps as in their own box.
+    assert_columns(
+        "a_domain_a_hundred_thousand_diameters_square",
+        Some(json!({ "x": [-5.0e4, 5.0e4], "z": [-2.0, 1.0e5 - 2.0] })),
+    );
+}
+
+/// The columns at x = 0 and x = 10⁴ d (`columns_scene`) settled on both paths: the same
+/// overlaps at both places, the straight ones the exact overlaps. `domain`: another
+/// domain than the columns' own box.
+fn assert_columns(name: &str, domain: Option<serde_json::Value>) {
     let offset = 1.0e4;
-    let v = columns_scene(offset);
-    let Some(mut g) = gpu_sim(
-        "overlaps_are_the_same_at_x_0_and_at_x_10000",
-        common::parse(&v),
-    ) else {
+    let mut v = columns_scene(offset);
+    if let Some(d) = &domain {
+        v["domain"] = d.clone();
+    }
+    let Some(mut g) = gpu_sim(name, common::parse(&v)) else {
         return;
     };
+    let cells = g.grid.nx as u64 * g.grid.nz as u64;
+    assert_eq!(
+        cells > talus::gpu::MAX_CELLS,
+        domain.is_some(),
+        "{name}: {cells} cells; hashed only in the wide domain"
+    );
     let mut cpu = common::sim(&v);
     let steps = 8000; // t = 4: the zig-zag columns rest (checked below)
     g.advance(steps).unwrap();
@@ -308,9 +332,9 @@ fn overlaps_are_the_same_at_x_0_and_at_x_10000_diameters() {
         straight_column_error(&cpu, 3 * n),
     ];
     eprintln!(
-        "kinetic {:.2e}, elastic {:.2e}; zig-zag overlaps from {smallest:.2e} d: x = 1e4 d vs \
-         x = 0 {zigzag:.2e}; straight columns vs exact (GPU 0, GPU 1e4, CPU 0, CPU 1e4): \
-         {straight:?}",
+        "{name}: kinetic {:.2e}, elastic {:.2e}; zig-zag overlaps from {smallest:.2e} d: x = \
+         1e4 d vs x = 0 {zigzag:.2e}; straight columns vs exact (GPU 0, GPU 1e4, CPU 0, CPU \
+         1e4): {straight:?}",
         e.kinetic(),
         e.elastic
     );

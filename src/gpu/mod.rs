@@ -39,8 +39,52 @@ pub const STEPS_PER_SUBMIT: u64 = 64;
 /// Workgroups of one dispatch at most (per dimension; the GPU path dispatches in one).
 pub const MAX_WORKGROUPS: u64 = 65535;
 
-/// Cells of the grid at most: one dispatch of `clear_cells` covers 65535 workgroups.
+/// Cells of a dense grid at most: one dispatch of `clear_cells` covers 65535 workgroups.
 pub const MAX_CELLS: u64 = MAX_WORKGROUPS * WG as u64;
+
+/// The spatial hash: the cell's coordinates times large primes (Teschner et al. 2003),
+/// mixed by Wellons's lowbias32 so that every bit of the bucket depends on both.
+pub const HASH_X: u32 = 73_856_093;
+pub const HASH_Z: u32 = 19_349_663;
+pub const HASH_MIX_1: u32 = 0x7feb_352d;
+pub const HASH_MIX_2: u32 = 0x846c_a68b;
+
+/// Buckets of a hashed grid at most (a power of two below MAX_CELLS).
+pub const MAX_BUCKETS: u64 = 1 << 21;
+
+/// Cells per side at most: anchors are i32 cell coordinates.
+pub const MAX_CELLS_PER_SIDE: u32 = 1 << 30;
+
+/// The bucket of cell (cx, cz) in a grid of `buckets` buckets (twin of `bucket` in
+/// common.wgsl): the cell itself when the grid is dense (nx nz ≤ buckets), else a
+/// spatial hash.
+pub fn bucket(grid: &crate::cell_list::Grid, buckets: u32, cx: u32, cz: u32) -> u32 {
+    if grid.nx > buckets / grid.nz {
+        let mut h = cx.wrapping_mul(HASH_X) ^ cz.wrapping_mul(HASH_Z);
+        h ^= h >> 16;
+        h = h.wrapping_mul(HASH_MIX_1);
+        h ^= h >> 15;
+        h = h.wrapping_mul(HASH_MIX_2);
+        h ^= h >> 16;
+        h % buckets
+    } else {
+        cz * grid.nx + cx
+    }
+}
+
+/// The buckets of the device's grid: every cell when they fit in MAX_CELLS (a dense
+/// grid), else about two per particle (issue 13: memory O(N) whatever the domain's
+/// area; a pour 10⁵ d wide runs).
+pub fn bucket_count(grid: &crate::cell_list::Grid, n_cap: u32) -> u64 {
+    let cells = grid.nx as u64 * grid.nz as u64;
+    if cells <= MAX_CELLS {
+        cells
+    } else {
+        (2 * n_cap as u64)
+            .next_power_of_two()
+            .clamp(1024, MAX_BUCKETS)
+    }
+}
 
 struct Buffers {
     params: wgpu::Buffer,
@@ -163,14 +207,15 @@ impl GpuSimulation {
         // tests/gpu_scenes.rs `lattice_pile_agrees_with_the_cpu`).
         let skin = sim.skin();
         let grid = sim.grid.coarsened(sim.grid.cell_size + skin);
-        let cells = grid.cell_count() as u64;
-        if cells > MAX_CELLS {
+        if grid.nx >= MAX_CELLS_PER_SIDE || grid.nz >= MAX_CELLS_PER_SIDE {
             return Err(DeviceError::TooLarge {
                 name: gpu.info.name.clone(),
                 reason: format!(
-                    "the cell grid has {cells} cells ({} × {}), the GPU path handles at most \
-                     {MAX_CELLS}; make the domain smaller",
-                    grid.nx, grid.nz
+                    "the cell grid has {} × {} cells, the GPU path handles at most {} per \
+                     side; make the domain smaller",
+                    grid.nx,
+                    grid.nz,
+                    MAX_CELLS_PER_SIDE - 1
                 ),
             }
             .into());
@@ -268,6 +313,7 @@ impl GpuSimulation {
         let n_now = sim.particles.len() as u32;
         let n_cap = (n_now + candidates.len() as u32 + layered_count).max(1);
         let table_cap = (8 * n_cap as u64).next_power_of_two().max(64);
+        let cells = bucket_count(&grid, n_cap);
 
         let law = &sim.law;
         let g = sim.scene.gravity.g;
@@ -1324,5 +1370,54 @@ fn law_params(law: &ContactLaw, p: &mut Params) {
             p.damping_fraction = c.damping_fraction as f32;
             p.g_scale = c.g as f32;
         }
+    }
+}
+
+#[cfg(test)]
+mod bucket_tests {
+    use super::*;
+    use crate::cell_list::Grid;
+
+    #[test]
+    fn a_dense_grid_is_its_own_buckets_and_a_wide_one_spreads_over_them() {
+        let small = Grid::new([0.0, 100.0], [0.0, 50.0], 1.0);
+        let b = bucket_count(&small, 1000) as u32;
+        assert_eq!(b as usize, small.cell_count());
+        assert_eq!(bucket(&small, b, 7, 3), 3 * small.nx + 7);
+        // 10⁵ × 10⁵ cells, 10⁴ particles: 2¹⁵ buckets.
+        let wide = Grid::new([0.0, 1e5], [0.0, 1e5], 1.0);
+        let b = bucket_count(&wide, 10_000) as u32;
+        assert_eq!(b, 1 << 15);
+        // A block of 256 × 256 cells spreads over the buckets like random draws (two
+        // per bucket: e⁻² = 13.5 % of them empty, none with more than a dozen), so a
+        // bucket holds few particles of other cells; and the 3 × 3 cells around a cell
+        // rarely share one.
+        let mut count = vec![0u32; b as usize];
+        let mut shared = 0;
+        for cz in 40_000..40_256 {
+            for cx in 10_000..10_256 {
+                let k = bucket(&wide, b, cx, cz);
+                assert!(k < b);
+                count[k as usize] += 1;
+                let mut around: Vec<u32> = (0..9)
+                    .map(|m| bucket(&wide, b, cx + m % 3 - 1, cz + m / 3 - 1))
+                    .collect();
+                around.sort();
+                around.dedup();
+                shared += 9 - around.len();
+            }
+        }
+        let empty = count.iter().filter(|&&c| c == 0).count() as f64 / b as f64;
+        let most = *count.iter().max().unwrap();
+        assert!(
+            (0.11..0.16).contains(&empty) && most <= 12,
+            "{:.3} of the buckets empty, the fullest holds {most} cells",
+            empty
+        );
+        // Random draws: 36/2¹⁵ of the neighbourhoods share a bucket.
+        assert!(
+            shared < 200,
+            "{shared} of 65536 neighbourhoods share a bucket"
+        );
     }
 }
