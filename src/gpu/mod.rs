@@ -72,17 +72,20 @@ pub fn bucket(grid: &crate::cell_list::Grid, buckets: u32, cx: u32, cz: u32) -> 
     }
 }
 
-/// The buckets of the device's grid: every cell when they fit in MAX_CELLS (a dense
-/// grid), else about two per particle (issue 13: memory O(N) whatever the domain's
-/// area; a pour 10⁵ d wide runs).
+/// The buckets of the device's grid: about two per particle when the grid has more
+/// than four times as many cells, or more than MAX_CELLS (a hashed grid: issue 13,
+/// memory and rebuild time O(N) whatever the domain's area, and a pour 10⁵ d wide
+/// runs); otherwise every cell (a dense grid, whose neighbouring cells are neighbours in
+/// memory).
 pub fn bucket_count(grid: &crate::cell_list::Grid, n_cap: u32) -> u64 {
     let cells = grid.nx as u64 * grid.nz as u64;
-    if cells <= MAX_CELLS {
-        cells
+    let hashed = (2 * n_cap as u64)
+        .next_power_of_two()
+        .clamp(1024, MAX_BUCKETS);
+    if cells > MAX_CELLS || cells > 4 * hashed {
+        hashed
     } else {
-        (2 * n_cap as u64)
-            .next_power_of_two()
-            .clamp(1024, MAX_BUCKETS)
+        cells
     }
 }
 
@@ -1380,7 +1383,9 @@ mod bucket_tests {
 
     #[test]
     fn a_dense_grid_is_its_own_buckets_and_a_wide_one_spreads_over_them() {
+        // 100 × 50 cells for 1000 particles: dense; for 100, hashed (2¹⁰ buckets).
         let small = Grid::new([0.0, 100.0], [0.0, 50.0], 1.0);
+        assert_eq!(bucket_count(&small, 100), 1024);
         let b = bucket_count(&small, 1000) as u32;
         assert_eq!(b as usize, small.cell_count());
         assert_eq!(bucket(&small, b, 7, 3), 3 * small.nx + 7);
