@@ -181,14 +181,17 @@ fn cell_list_matches_the_cpu() {
 
 #[test]
 fn prefix_sum_matches_the_cpu_on_all_three_levels() {
-    // A domain of 400 × 400 cells (of 2 d: the unit cells doubled to hold the
-    // neighbour lists' skin): 160 000 counts, 625 level-1 blocks, 3 level-2 blocks.
-    let mut v = random_scene(20, spring_dashpot(), 2);
+    // A domain of 333 × 333 cells (of 2.4 d: the largest diameter's cells doubled to
+    // hold the neighbour lists' skin): 110 889 counts, several level-1 and level-2
+    // blocks. 20 000 particles, so that the grid stays dense (a grid with more than four
+    // times its ~2 buckets per particle is hashed).
+    let mut v = random_scene(20_000, spring_dashpot(), 2);
     v["domain"] = json!({ "x": [-3.0, 797.0], "z": [-3.0, 797.0] });
     let Some(mut g) = setup("prefix_sum_matches_the_cpu_on_all_three_levels", &v) else {
         return;
     };
     let cells = g.params.cells as usize;
+    assert_eq!(cells, (g.params.nx * g.params.nz) as usize, "a dense grid");
     assert!(g.params.scan_blocks2 > 1, "the test must reach level 2");
     let mut rng = Rng::new(5);
     let counts: Vec<u32> = (0..cells).map(|_| (rng.uniform() * 4.0) as u32).collect();
