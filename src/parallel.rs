@@ -111,9 +111,23 @@ where
     U: Send,
     F: Fn(usize, [&mut T; 6], &mut U) + Sync + Send,
 {
+    let mut none = vec![(); w.len()];
+    for_each6_with2(v, w, &mut none, |k, q, y, _| f(k, q, y));
+}
+
+/// f(k, [&mut v0[k], …, &mut v5[k]], &mut w[k], &mut x[k]) for every k: a particle's six
+/// Gear values and two more values of it.
+pub fn for_each6_with2<T, U, V, F>(v: &mut [Vec<T>; 6], w: &mut [U], x: &mut [V], f: F)
+where
+    T: Send,
+    U: Send,
+    V: Send,
+    F: Fn(usize, [&mut T; 6], &mut U, &mut V) + Sync + Send,
+{
     let [a, b, c, d, e, g] = v;
     let n = a.len();
     assert_eq!(w.len(), n);
+    assert_eq!(x.len(), n);
     if parallel(n) {
         a.par_iter_mut()
             .zip(b.par_iter_mut())
@@ -122,13 +136,14 @@ where
             .zip(e.par_iter_mut())
             .zip(g.par_iter_mut())
             .zip(w.par_iter_mut())
+            .zip(x.par_iter_mut())
             .enumerate()
             .with_min_len(chunk(n))
-            .for_each(|(k, ((((((q0, q1), q2), q3), q4), q5), x))| {
-                f(k, [q0, q1, q2, q3, q4, q5], x)
+            .for_each(|(k, (((((((q0, q1), q2), q3), q4), q5), y), z))| {
+                f(k, [q0, q1, q2, q3, q4, q5], y, z)
             });
     } else {
-        for (k, ((((((q0, q1), q2), q3), q4), q5), x)) in a
+        for (k, (((((((q0, q1), q2), q3), q4), q5), y), z)) in a
             .iter_mut()
             .zip(b.iter_mut())
             .zip(c.iter_mut())
@@ -136,9 +151,10 @@ where
             .zip(e.iter_mut())
             .zip(g.iter_mut())
             .zip(w.iter_mut())
+            .zip(x.iter_mut())
             .enumerate()
         {
-            f(k, [q0, q1, q2, q3, q4, q5], x);
+            f(k, [q0, q1, q2, q3, q4, q5], y, z);
         }
     }
 }

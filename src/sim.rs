@@ -113,6 +113,9 @@ pub struct Simulation {
     sorted: (Vec<u32>, u64),
     /// Whether the next evaluation rebuilds the list whatever the motion.
     force_rebuild: bool,
+    /// Inside `advance`: the state is already predicted for the next step and surveyed
+    /// (`correct_ahead`); the survey's answer.
+    predicted: Option<bool>,
 }
 
 impl Simulation {
@@ -186,6 +189,7 @@ impl Simulation {
             reorders: 0,
             sorted: (Vec::new(), 0),
             force_rebuild: false,
+            predicted: None,
         })
     }
 
@@ -245,30 +249,57 @@ impl Simulation {
     /// read and write of the Gear values instead of two (bitwise the same as
     /// `gear::predict` followed by `survey`).
     fn survey_with(&mut self, predict: bool) -> bool {
-        let (list, dt) = (&self.neighbours, self.scene.dt);
-        let check_moves = !list.stale(&self.particles);
-        let moved = AtomicBool::new(false);
-        let lost = AtomicUsize::new(usize::MAX);
+        let watch = SurveyWatch::new(&self.neighbours, &self.ids, &self.particles, self.scene.dt);
         let p = &mut self.particles;
         self.velocity.resize(p.len(), [0.0; 3]);
-        let (q, active, fixed, ids) = (&mut p.q, &p.active, &p.fixed, &self.ids);
+        let (q, active, fixed) = (&mut p.q, &p.active, &p.fixed);
         crate::parallel::for_each6_with(q, &mut self.velocity, |i, v, velocity| {
             let [q0, q1, q2, q3, q4, q5] = v;
             if predict && active[i] && !fixed[i] {
                 gear::predict_in_place([&mut *q0, &mut *q1, q2, q3, q4, q5]);
             }
-            let (q0, q1) = (*q0, *q1);
-            *velocity = [q1[0] / dt, q1[1] / dt, q1[2] / dt];
-            if check_moves && list.moved_to(i, q0, active[i]) {
-                moved.store(true, Ordering::Relaxed);
-            }
-            if active[i] && !q0.iter().all(|v| v.is_finite()) {
-                lost.fetch_min(ids[i] as usize, Ordering::Relaxed);
-            }
+            watch.survey_one(i, *q0, *q1, active[i], velocity);
         });
-        let lost = lost.into_inner();
-        self.lost_position = (lost != usize::MAX).then_some(lost);
-        moved.into_inner()
+        watch.finish(&mut self.lost_position)
+    }
+
+    /// Gear's correction of this step, the boundaries, and the prediction and survey
+    /// of the next step in one pass over the particles, for a step that another follows
+    /// at once with no insertion due: bitwise the same as `gear::correct`,
+    /// `remove_escaped`, then the next step's `survey_with(true)`, with one read and
+    /// write of the Gear values instead of two. Returns the survey's answer.
+    fn correct_ahead(&mut self, gravity: [f64; 2]) -> bool {
+        let (dt, d) = (self.scene.dt, &self.scene.domain);
+        let (x, z) = (d.x, d.z);
+        let escaped = AtomicUsize::new(0);
+        let (list, kicks) = (&self.neighbours, &self.candidates.kicks);
+        let watch = SurveyWatch::new(list, &self.ids, &self.particles, dt);
+        let p = &mut self.particles;
+        let (q, active, fixed, mass, inertia) =
+            (&mut p.q, &mut p.active, &p.fixed, &p.mass, &p.inertia);
+        crate::parallel::for_each6_with2(q, &mut self.velocity, active, |i, v, velocity, on| {
+            let [q0, q1, q2, q3, q4, q5] = v;
+            let integrated = *on && !fixed[i];
+            if integrated {
+                let a = crate::integrate::acceleration(
+                    kick_sum(list, kicks, i),
+                    mass[i],
+                    inertia[i],
+                    gravity,
+                );
+                gear::correct_in_place([&mut *q0, &mut *q1, q2, q3, q4, q5], a, dt);
+            }
+            if *on && outside(x, z, *q0) {
+                *on = false;
+                escaped.fetch_add(1, Ordering::Relaxed);
+            }
+            if integrated && *on {
+                gear::predict_in_place([&mut *q0, &mut *q1, q2, q3, q4, q5]);
+            }
+            watch.survey_one(i, *q0, *q1, *on, velocity);
+        });
+        self.lost += escaped.into_inner() as u64;
+        watch.finish(&mut self.lost_position)
     }
 
     /// Stages 2–8 at the current (predicted) state: the neighbour list (rebuilt when a
@@ -414,7 +445,7 @@ impl Simulation {
             self.sort_by_cell();
             self.reorder = true;
             self.record_contacts = false;
-            done = (1..steps).try_for_each(|_| self.step());
+            done = (1..steps).try_for_each(|k| self.step_with(k + 1 < steps));
             self.reorder = false;
             self.restore_id_order(done.is_err());
             left = 1;
@@ -422,7 +453,7 @@ impl Simulation {
         if done.is_ok() {
             done = (0..left).try_for_each(|k| {
                 self.record_contacts = k + 1 == left;
-                self.step()
+                self.step_with(k + 1 < left)
             });
         }
         self.record_contacts = true;
@@ -504,32 +535,61 @@ impl Simulation {
     /// One time step: insert, predict, neighbour list, contacts and forces, springs,
     /// reduce, correct, boundaries.
     pub fn step(&mut self) -> Result<(), Divergence> {
+        self.step_with(false)
+    }
+
+    /// `step`; `ahead`: the caller steps again at once (inside `advance`), so that Gear
+    /// may predict and survey the next step in this step's correction pass
+    /// (`correct_ahead`) when no insertion is due then.
+    fn step_with(&mut self, ahead: bool) -> Result<(), Divergence> {
         let dt = self.scene.dt;
         let t = self.time();
         self.sync_ids();
-        self.insert_from_sources(t);
         let gear = self.scene.integrator == IntegratorKind::Gear5;
-        // Gear predicts each particle in the survey's pass.
-        let moved = self.survey_with(gear);
+        let moved = match self.predicted.take() {
+            // The last step predicted and surveyed this one (no insertion was due).
+            Some(moved) => moved,
+            None => {
+                self.insert_from_sources(t);
+                // Gear predicts each particle in the survey's pass.
+                self.survey_with(gear)
+            }
+        };
         self.evaluate_surveyed(moved);
         self.check_divergence()?;
         // The candidates' updated springs become the list's.
         std::mem::swap(&mut self.neighbours.history, &mut self.candidates.history);
         self.committed = true;
-        // Each particle's force is summed from its candidates' kicks where it is used.
-        let (list, kicks) = (&self.neighbours, &self.candidates.kicks);
-        let force = |i: usize| kick_sum(list, kicks, i);
         if gear {
             // Forces were evaluated at the predicted state, i.e. at time t + dt.
             let g = self.gravity(t + dt);
-            gear::correct(&mut self.particles, force, g, dt);
+            let next = (self.step + 1) as f64 * dt;
+            if ahead && !self.insertion_due(next) {
+                self.predicted = Some(self.correct_ahead(g));
+            } else {
+                // Each particle's force is summed from its candidates' kicks where it is
+                // used.
+                let (list, kicks) = (&self.neighbours, &self.candidates.kicks);
+                gear::correct(&mut self.particles, |i| kick_sum(list, kicks, i), g, dt);
+                self.remove_escaped();
+            }
         } else {
             let g = self.gravity(t);
-            leapfrog::kick_drift(&mut self.particles, force, g, dt);
+            let (list, kicks) = (&self.neighbours, &self.candidates.kicks);
+            leapfrog::kick_drift(&mut self.particles, |i| kick_sum(list, kicks, i), g, dt);
+            self.remove_escaped();
         }
-        self.remove_escaped();
         self.step += 1;
         Ok(())
+    }
+
+    /// Whether a source or layered block tries to insert at time t.
+    fn insertion_due(&self, t: f64) -> bool {
+        let (sources, layered) = creators(&self.scene);
+        let p = sources.len();
+        let pour = (sources.iter().zip(&self.sources)).any(|(s, st)| create::source::due(s, st, t));
+        pour || (layered.iter().zip(&self.sources[p..]))
+            .any(|(l, st)| create::layered::due(l, st, t))
     }
 
     fn insert_from_sources(&mut self, t: f64) {
@@ -613,8 +673,7 @@ impl Simulation {
             if !self.particles.active[i] {
                 continue;
             }
-            let p = self.particles.q[0][i];
-            if p[0] < d.x[0] || p[0] > d.x[1] || p[1] < d.z[0] || p[1] > d.z[1] {
+            if outside(d.x, d.z, self.particles.q[0][i]) {
                 self.particles.active[i] = false;
                 self.lost += 1;
             }
@@ -642,6 +701,59 @@ impl Simulation {
         e.elastic = self.contacts.iter().map(|c| c.energy).sum();
         e
     }
+}
+
+/// What the survey of the particles watches for (`Simulation::survey_with`): motion
+/// beyond the skin of the neighbour list and positions that are not finite.
+struct SurveyWatch<'a> {
+    list: &'a NeighbourList,
+    ids: &'a [u32],
+    dt: f64,
+    /// Whether the list is not stale anyway (then each particle's motion is checked).
+    check_moves: bool,
+    moved: AtomicBool,
+    /// The smallest id of an active particle whose position is not finite.
+    lost: AtomicUsize,
+}
+
+impl<'a> SurveyWatch<'a> {
+    fn new(list: &'a NeighbourList, ids: &'a [u32], particles: &Particles, dt: f64) -> Self {
+        SurveyWatch {
+            list,
+            ids,
+            dt,
+            check_moves: !list.stale(particles),
+            moved: AtomicBool::new(false),
+            lost: AtomicUsize::new(usize::MAX),
+        }
+    }
+
+    /// Particle i at the state about to be evaluated: its velocity q1/dt (what every
+    /// contact reads), whether it has moved beyond the skin, whether it is lost.
+    #[inline(always)]
+    fn survey_one(&self, i: usize, q0: Dof, q1: Dof, active: bool, velocity: &mut Dof) {
+        let dt = self.dt;
+        *velocity = [q1[0] / dt, q1[1] / dt, q1[2] / dt];
+        if self.check_moves && self.list.moved_to(i, q0, active) {
+            self.moved.store(true, Ordering::Relaxed);
+        }
+        if active && !q0.iter().all(|v| v.is_finite()) {
+            self.lost.fetch_min(self.ids[i] as usize, Ordering::Relaxed);
+        }
+    }
+
+    /// Notes the first lost position; returns whether a particle moved beyond the skin.
+    fn finish(self, lost_position: &mut Option<usize>) -> bool {
+        let lost = self.lost.into_inner();
+        *lost_position = (lost != usize::MAX).then_some(lost);
+        self.moved.into_inner()
+    }
+}
+
+/// Whether a position lies outside the domain [x0, x1] × [z0, z1] (a NaN does not).
+#[inline(always)]
+fn outside(x: [f64; 2], z: [f64; 2], p: Dof) -> bool {
+    p[0] < x[0] || p[0] > x[1] || p[1] < z[0] || p[1] > z[1]
 }
 
 /// The point sources and the layered blocks of a scene, each in block order.

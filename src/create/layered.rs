@@ -132,6 +132,13 @@ fn row_positions(spec: &Layered, particles: &Particles, k: u32) -> Vec<f64> {
     }
 }
 
+/// Whether a row is due at time t (`emit` is a no-op otherwise). Time first: `max_rows`
+/// samples the polygon family for its reach (milliseconds), and this runs every step.
+pub fn due(spec: &Layered, state: &SourceState, t: f64) -> bool {
+    let k = state.inserted;
+    t >= spec.start_time + k as f64 * spec.interval && k < max_rows(spec)
+}
+
 /// The particles of the rows due by time t (at most one row per call).
 pub fn emit(
     spec: &Layered,
@@ -140,12 +147,10 @@ pub fn emit(
     material: u32,
     particles: &Particles,
 ) -> Vec<NewParticle> {
-    let k = state.inserted;
-    // Time first: `max_rows` samples the polygon family for its reach (milliseconds),
-    // and this runs every step.
-    if t < spec.start_time + k as f64 * spec.interval || k >= max_rows(spec) {
+    if !due(spec, state, t) {
         return Vec::new();
     }
+    let k = state.inserted;
     let d = largest(spec);
     let xs = row_positions(spec, particles, k);
     if xs.is_empty() {

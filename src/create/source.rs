@@ -96,6 +96,11 @@ pub fn due_time(spec: &PointSource, k: u32) -> f64 {
     spec.start_time + k as f64 / spec.rate
 }
 
+/// Whether the source tries to insert at time t (`emit` is a no-op otherwise).
+pub fn due(spec: &PointSource, state: &SourceState, t: f64) -> bool {
+    !state.done(spec) && t >= due_time(spec, state.inserted)
+}
+
 fn size(s: &Size, rng: &mut Rng) -> f64 {
     let (lo, hi) = s.bounds();
     if lo == hi { lo } else { rng.range(lo, hi) }
@@ -202,10 +207,7 @@ pub fn emit(
     particles: &Particles,
 ) -> Vec<NewParticle> {
     let mut out = Vec::new();
-    while !state.done(spec)
-        && t >= due_time(spec, state.inserted)
-        && (out.len() as u32) < MAX_PER_STEP
-    {
+    while due(spec, state, t) && (out.len() as u32) < MAX_PER_STEP {
         let drawn = match state.pending.take() {
             Some(p) => p,
             None => draw(spec, &mut state.rng),

@@ -81,11 +81,18 @@ where
     crate::parallel::for_each6(q, |i, v| {
         if active[i] && !fixed[i] {
             let a = super::acceleration(force(i), mass[i], inertia[i], gravity);
-            let mut q = [*v[0], *v[1], *v[2], *v[3], *v[4], *v[5]];
-            correct_one(&mut q, a, dt, &CORRECTOR);
-            for (dst, src) in v.into_iter().zip(q) {
-                *dst = src;
-            }
+            correct_in_place(v, a, dt);
         }
     });
+}
+
+/// `correct_one` (velocity-dependent forces) on the six values of a particle where they
+/// are stored.
+#[inline(always)]
+pub fn correct_in_place(v: [&mut Dof; GEAR_VALUES], accel: Dof, dt: f64) {
+    let mut q = [*v[0], *v[1], *v[2], *v[3], *v[4], *v[5]];
+    correct_one(&mut q, accel, dt, &CORRECTOR);
+    for (dst, src) in v.into_iter().zip(q) {
+        *dst = src;
+    }
 }
