@@ -292,8 +292,18 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
     let r = sqrt(r2);
     var cur = 0u;
     let nq = (*q).n;
-    var a = corner_at(q, 0u, h);
-    for (var k = 0u; k < nq; k++) {
+    // The edges are clipped from the corner of q that points most towards p (overlap.rs
+    // `clip_by`): its two edges cut p down to the few corners near the contact first.
+    var first = 0u;
+    var most = dot(corner_at(q, 0u, h), ci - cj);
+    for (var k = 1u; k < nq; k++) {
+        let along = dot(corner_at(q, k, h), ci - cj);
+        if (along > most) { most = along; first = k; }
+    }
+    first = (first + nq - 1u) % nq;
+    var a = corner_at(q, first, h);
+    for (var e = 0u; e < nq; e++) {
+        let k = (first + e) % nq;
         let b = corner_at(q, (k + 1u) % nq, h);
         let m = vec2<f32>(-(b.y - a.y), b.x - a.x);
         let reach = r * length(m);

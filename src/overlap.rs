@@ -176,47 +176,68 @@ fn origin_of(line_in: u32, line_out: u32) -> Origin {
     }
 }
 
-/// Particle j's corners (relative to r_j) in i's frame, d = r_i − r_j.
-fn in_frame_of_i(q: &[P2], d: P2) -> ([P2; MAX_CORNERS as usize], usize) {
-    let mut out = [[0.0; 2]; MAX_CORNERS as usize];
-    for (o, x) in out.iter_mut().zip(q) {
+/// Particle j's corners (relative to r_j) in i's frame, d = r_i − r_j, into `out`.
+fn in_frame_of_i(q: &[P2], d: P2, out: &mut Clip) {
+    out.n = q.len();
+    for (o, x) in out.v.iter_mut().zip(q) {
         *o = sub(*x, d);
     }
-    (out, q.len())
 }
 
 /// The overlap polygon: p (centred on the origin) clipped by the edges of q, both
-/// convex and counter-clockwise in i's frame. The lines of the clipped polygon's edges
-/// tell where each of its corners comes from; the crossings come out of the clipping,
-/// with no extra search.
-/// Returns which of `buf`'s first two polygons holds the result.
-fn clip_by(p: &[P2], q: &[P2], buf: &mut [Clip; 3]) -> usize {
-    buf[0].set_outline(p, 0);
+/// convex and counter-clockwise in i's frame (q's centre at −d). The lines of the
+/// clipped polygon's edges tell where each of its corners comes from; the crossings come
+/// out of the clipping, with no extra search.
+/// Returns which of the two scratch polygons `buf` holds the result.
+fn clip_by(p: &[P2], q: &[P2], d: P2, buf: [&mut Clip; 2]) -> usize {
+    let [x, y] = buf;
+    x.set_outline(p, 0);
     let mut cur = 0;
     // p lies in the circle of radius r about its centre: an edge line of q that keeps
     // the whole circle inside clips nothing, one that keeps it all outside leaves no
     // overlap. Only the few edges near the contact are clipped.
     let r = p.iter().map(|v| dot(*v, *v)).fold(0.0, f64::max).sqrt();
+    // The edges are clipped from the corner of q that points most towards p (the
+    // largest q_k·d): its two edges cut p down to the few corners near the contact
+    // first, and the later clips treat those few instead of all of p.
     let nq = q.len();
-    for k in 0..nq {
+    let first = (0..nq).fold(0, |best, k| {
+        if dot(q[k], d) > dot(q[best], d) {
+            k
+        } else {
+            best
+        }
+    });
+    let first = if first == 0 { nq - 1 } else { first - 1 };
+    for e in 0..nq {
+        let (src, dst) = if cur == 0 {
+            (&*x, &mut *y)
+        } else {
+            (&*y, &mut *x)
+        };
+        if src.n == 0 {
+            break;
+        }
+        let k = if first + e >= nq {
+            first + e - nq
+        } else {
+            first + e
+        };
         let (a, b) = (q[k], q[if k + 1 == nq { 0 } else { k + 1 }]);
         let m = [-(b[1] - a[1]), b[0] - a[0]];
         let centre = -dot(a, m);
         match circle_side(centre, r, m) {
             Side::Inside => continue,
             Side::Outside => {
-                buf[cur].n = 0;
+                // No overlap: the result is an empty polygon.
+                dst.n = 0;
+                cur = 1 - cur;
                 break;
             }
             Side::Across => {}
         }
-        let [x, y, _] = buf;
-        let (src, dst) = if cur == 0 { (&*x, y) } else { (&*y, x) };
         clip_lines(src, a, m, Q_LINE + k as u32, dst);
         cur = 1 - cur;
-        if buf[cur].n == 0 {
-            break;
-        }
     }
     cur
 }
@@ -269,9 +290,14 @@ fn circle_side_exact(centre: f64, r: f64, m: P2) -> Side {
 /// d = r_i − r_j: the contact test of the broad phase's survivors, by the same clipping
 /// as [`polygon_polygon`].
 pub fn overlap_area(p: &[P2], q: &[P2], d: P2) -> f64 {
-    let (q, nq) = in_frame_of_i(q, d);
     with_scratch(|buf| {
-        let o = &buf[clip_by(p, &q[..nq], buf)];
+        let [x, y, qi] = buf;
+        in_frame_of_i(q, d, qi);
+        let o = if clip_by(p, qi.corners(), d, [&mut *x, &mut *y]) == 0 {
+            x
+        } else {
+            y
+        };
         if o.n < 3 {
             return 0.0;
         }
@@ -323,11 +349,13 @@ fn unit_or_up(d: P2) -> P2 {
 /// to their own centres, both convex and counter-clockwise, d = r_i − r_j. None when
 /// the outlines do not overlap.
 pub fn polygon_polygon(p: &[P2], q: &[P2], d: P2) -> Option<AreaContact> {
-    let (qi, nq) = in_frame_of_i(q, d);
     with_scratch(|buf| {
-        let k = clip_by(p, &qi[..nq], buf);
-        let [x, y, crossed] = buf;
-        overlap_contact(if k == 0 { x } else { y }, crossed, p, q, d)
+        // The third scratch polygon holds q in i's frame for the clipping, then the
+        // crossings.
+        let [x, y, qi] = buf;
+        in_frame_of_i(q, d, qi);
+        let k = clip_by(p, qi.corners(), d, [&mut *x, &mut *y]);
+        overlap_contact(if k == 0 { x } else { y }, qi, p, q, d)
     })
 }
 

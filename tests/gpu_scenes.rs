@@ -559,9 +559,28 @@ fn assert_pour_agrees(name: &str, scene: fn() -> talus::scene::Scene) {
         (a.com[1] - b.com[1]).abs() < 0.15 * b.com[1],
         "centre of mass height"
     );
+    // The settled heap's contact count differs between realizations by more than a
+    // single pair of runs can tell (heptagons, 10 seeds on the CPU path: 82–99), so the
+    // GPU's is compared with the CPU path's spread over seeds. Allowed on top of 3
+    // standard deviations: 10 % of the mean, for the f32 path's excess of contacts
+    // (measured over 5 seeds each: 98.6 ± 3.4 against 91.1 ± 4.9; issue 14 item 5,
+    // contact existence from the exact test).
+    let counts: Vec<f64> = (0..10)
+        .map(|k| {
+            let mut s = scene();
+            s.seed += k;
+            let mut cpu = Simulation::new(s).unwrap();
+            (0..early + late).for_each(|_| cpu.step().unwrap());
+            cpu.pairs.len() as f64
+        })
+        .collect();
+    let mean = counts.iter().sum::<f64>() / counts.len() as f64;
+    let var = counts.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / (counts.len() - 1) as f64;
     assert!(
-        (a.contacts as f64 - b.contacts as f64).abs() < 0.2 * b.contacts as f64,
-        "contact count"
+        (a.contacts as f64 - mean).abs() <= 3.0 * var.sqrt() + 0.1 * mean,
+        "contact count {} against {mean:.1} ± {:.1} over 10 seeds on the CPU path",
+        a.contacts,
+        var.sqrt()
     );
 }
 
