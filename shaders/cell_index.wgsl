@@ -9,6 +9,7 @@
 fn clear_cells(@builtin(global_invocation_id) gid: vec3<u32>,
                @builtin(num_workgroups) groups: vec3<u32>) {
     if (!rebuilding()) { return; }
+    if (gid.x == 0u) { atomicStore(&control[C_INACTIVE], 0u); }
     let stride = groups.x * WG;
     for (var c = gid.x; c < max(params.cells, params.n_cap); c += stride) {
         if (c < params.cells) { atomicStore(&cell_count[c], 0u); }
@@ -20,7 +21,15 @@ fn clear_cells(@builtin(global_invocation_id) gid: vec3<u32>,
 fn cell_index(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= params.n_cap || !rebuilding()) { return; }
-    if (i >= live() || !is_active(i)) { cell_of[i] = EMPTY; return; }
+    if (i >= live()) { cell_of[i] = EMPTY; return; }
+    if (!is_active(i)) {
+        cell_of[i] = EMPTY;
+        // The inactive particles fill `sorted` from the end of the live ones (in no
+        // particular order): after the active ones in cell order, the new memory order
+        // of permute.wgsl.
+        sorted[live() - 1u - atomicAdd(&control[C_INACTIVE], 1u)] = i;
+        return;
+    }
     let c = cell_coords(state[i].anchor);
     cell_of[i] = bucket(c);
 }

@@ -28,7 +28,10 @@ const C_HALT_ID: u32 = 5u;
 const C_LISTS: u32 = 6u;
 // How many times the lists were built.
 const C_REBUILDS: u32 = 7u;
-const C_BLOCKED: u32 = 8u;
+// Inactive particles counted by cell_index at a rebuild (they go last in the new memory
+// order, `permute_gather`).
+const C_INACTIVE: u32 = 9u;
+const C_BLOCKED: u32 = 10u;
 // control[C_LISTS]: REBUILD, the lists are rebuilt this step (a particle moved more
 // than skin/2, or was inserted or removed, or the state was uploaded); TABLE_CURRENT,
 // the spring table holds the springs (an upload: the first rebuild takes them from it
@@ -96,6 +99,9 @@ struct Params {
     inv_unit: f32,
     // the neighbour lists' skin (length units)
     skin: f32,
+    // 1: sort the particles in memory by cell at every rebuild (permute.wgsl); 0: keep
+    // them where they are (tests: the results must not depend on it)
+    reorder: u32,
 };
 
 // Dynamic state: q[0] = (rem_x, rem_z, rem_theta, 0) with the position's remainder in
@@ -202,6 +208,15 @@ struct Candidate {
 // Polygon corners in whole position units (counter-clockwise, centroid at the origin):
 // xy in the body frame, zw rotated to the particle's orientation (orientation.wgsl).
 @group(0) @binding(20) var<storage, read_write> corners: array<vec4<i32>>;
+// Each memory slot's particle id (issue 13 item 4): the particles are sorted in memory
+// by cell at every rebuild; ids never change, and every choice of order (a pair's lower
+// id, the order of sums, the spring table's keys, the reported particle) goes by id, so
+// no result depends on where a particle lies in memory.
+@group(0) @binding(21) var<storage, read_write> ids: array<u32>;
+// The particles in their new order, on the way (permute.wgsl).
+@group(0) @binding(22) var<storage, read_write> state_next: array<State>;
+@group(0) @binding(23) var<storage, read_write> props_next: array<Props>;
+@group(0) @binding(24) var<storage, read_write> ids_next: array<u32>;
 // The spring table keyed by pair: touched only at a rebuild of the lists, which stores
 // the old lists' springs into it and gathers the new lists' from it (issue 13).
 @group(1) @binding(0) var<storage, read_write> table: array<Entry>;
@@ -239,12 +254,19 @@ fn live() -> u32 {
     return atomicLoad(&control[C_LIVE]);
 }
 
-// Stops the run: the first step and the lowest particle id are kept (atomic min, so the
-// report does not depend on thread timing).
-fn halt(reason: u32, id: u32) {
+// Stops the run because of the particle in memory slot i: the first step and the lowest
+// particle id are kept (atomic min, so the report depends neither on thread timing nor
+// on the memory order).
+fn halt(reason: u32, i: u32) {
     atomicOr(&control[C_HALT], reason);
     atomicMin(&control[C_HALT_STEP], atomicLoad(&control[C_STEP]));
-    atomicMin(&control[C_HALT_ID], id);
+    atomicMin(&control[C_HALT_ID], ids[i]);
+}
+
+// The spring table's key for partner j of a candidate: its id, or the wall's code.
+fn partner_key(j: u32) -> u32 {
+    if (j >= WALL_BASE) { return j; }
+    return ids[j];
 }
 
 // Gravity at the given step (ramped linearly, paper 000 sec. 4).

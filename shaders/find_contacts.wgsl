@@ -1,6 +1,6 @@
 // Stage (src/neighbours.rs `list_candidates`; at a rebuild of the lists only): for
-// particle i, every j > i in the 3x3 cells around it whose circles come within the
-// skin of the law's range, sorted by j, then its walls. Each candidate is also entered
+// particle i, every j of a higher id in the 3x3 cells around it whose circles come
+// within the skin of the law's range, sorted by id, then its walls. Each candidate is also entered
 // in j's `down` list (slot index i * MAX_CONTACTS + k), which the reduction needs; that
 // list is filled by atomics and sorted where it is read. Whether a candidate touches is
 // decided at every step, in contact_forces (`touches`, `touches_wall`).
@@ -37,7 +37,9 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= live() || halted() || !is_active(i)) { contact_count[i] = 0u; return; }
     mark_listed(i);
     var found: array<u32, MAX_CONTACTS>;
+    var found_id: array<u32, MAX_CONTACTS>;
     var n = 0u;
+    let id_i = ids[i];
     let fixed_i = is_fixed(i);
     let c = cell_coords(state[i].anchor);
     let z0 = max(i32(c.y) - 1, 0);
@@ -52,16 +54,23 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
             let end = start + atomicLoad(&cell_count[cell]);
             for (var s = start; s < end; s++) {
                 let j = sorted[s];
-                if (j <= i || (fixed_i && is_fixed(j))) { continue; }
+                let id_j = ids[j];
+                if (id_j <= id_i || (fixed_i && is_fixed(j))) { continue; }
                 // A bucket of a hashed grid may hold other cells too (and be visited
                 // for each of them): only this cell's particles count here.
                 if (hashed && any(cell_coords(state[j].anchor) != vec2<u32>(x, z))) { continue; }
                 if (!is_candidate(i, j)) { continue; }
                 if (n == MAX_CONTACTS) { halt(HALT_CONTACTS_FULL, i); break; }
-                // Insertion sort by j: the order must not depend on the cell layout.
+                // Insertion sort by id: the order must not depend on the cell layout or
+                // on the memory order.
                 var k = n;
-                while (k > 0u && found[k - 1u] > j) { found[k] = found[k - 1u]; k--; }
+                while (k > 0u && found_id[k - 1u] > id_j) {
+                    found[k] = found[k - 1u];
+                    found_id[k] = found_id[k - 1u];
+                    k--;
+                }
                 found[k] = j;
+                found_id[k] = id_j;
                 n++;
             }
         }

@@ -2,8 +2,9 @@
 // candidate's tangential history from the spring table, where the rebuild has just
 // stored the old lists' springs (store_history); a missing key is a pair that was not in
 // contact (0).
-// The table: open addressing, linear probing, key (i, j) with i < j, i claimed by
-// compare-and-swap. Only the thread of particle i ever writes keys with first id i, so
+// The table: open addressing, linear probing, key (i, j) of ids (or a wall's code for
+// j) with i < j, i claimed by compare-and-swap. Only the thread of particle i ever
+// writes keys with first id i, so
 // two threads never race for the same key; slot positions may vary between runs but a
 // lookup always finds the one entry of its key, so results are deterministic.
 
@@ -24,6 +25,6 @@ fn gather_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= live() || halted() || !rebuilding()) { return; }
     for (var k = 0u; k < contact_count[i]; k++) {
         let slot = i * MAX_CONTACTS + k;
-        hist_in[slot] = lookup(i, contact_j[slot]);
+        hist_in[slot] = lookup(ids[i], partner_key(contact_j[slot]));
     }
 }

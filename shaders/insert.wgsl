@@ -62,6 +62,8 @@ fn insert_place() {
             st.anchor = cand.anchor;
             st.frac = cand.frac;
             state[n] = st;
+            // Ids are never reused: a new particle's is the number of particles so far.
+            ids[n] = n;
             props[n] = Props(cand.radius, cand.mass, cand.inv_inertia, cand.flags,
                              cand.radius_units, cand.radius_rem, cand.shape);
             rotate_corners(n, st);

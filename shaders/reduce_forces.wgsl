@@ -1,6 +1,7 @@
 // Stage (src/forces.rs `reduce_forces`): each particle sums its own contacts' forces in
 // a fixed order, with no float atomics: first the contacts where it is the higher id
-// (sorted by the lower id, as they come in the CPU's contact list), then its own.
+// (sorted by the lower id, as they come in the CPU's contact list, whatever the memory
+// order), then its own.
 
 @compute @workgroup_size(WG)
 fn reduce_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
@@ -9,11 +10,19 @@ fn reduce_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
     var acc = vec3<f32>(0.0);
     let nd = min(atomicLoad(&down_count[p]), MAX_CONTACTS);
     var slots: array<u32, MAX_CONTACTS>;
+    var keys: array<u32, MAX_CONTACTS>;
     for (var a = 0u; a < nd; a++) {
         let s = down[p * MAX_CONTACTS + a];
+        // Each lower particle lists p once: its id orders the sum.
+        let key = ids[s / MAX_CONTACTS];
         var k = a;
-        while (k > 0u && slots[k - 1u] > s) { slots[k] = slots[k - 1u]; k--; }
+        while (k > 0u && keys[k - 1u] > key) {
+            slots[k] = slots[k - 1u];
+            keys[k] = keys[k - 1u];
+            k--;
+        }
         slots[k] = s;
+        keys[k] = key;
     }
     for (var a = 0u; a < nd; a++) {
         let ft = contact_out[slots[a]].ft;

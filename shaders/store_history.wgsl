@@ -20,7 +20,8 @@ fn clear_table(@builtin(global_invocation_id) gid: vec3<u32>,
     }
 }
 
-fn insert(i: u32, j: u32, value: f32) {
+// Key (id of i, partner key of j); `owner`: i's memory slot (for a halt).
+fn insert(i: u32, j: u32, value: f32, owner: u32) {
     var slot = hash_pair(i, j) & params.table_mask;
     for (var probe = 0u; probe <= params.table_mask; probe++) {
         let r = atomicCompareExchangeWeak(&table[slot].i, EMPTY, i);
@@ -32,7 +33,7 @@ fn insert(i: u32, j: u32, value: f32) {
         if (r.old_value == EMPTY) { continue; } // spurious failure: try the slot again
         slot = (slot + 1u) & params.table_mask;
     }
-    halt(HALT_TABLE_FULL, i);
+    halt(HALT_TABLE_FULL, owner);
 }
 
 @compute @workgroup_size(WG)
@@ -41,6 +42,8 @@ fn store_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= live() || halted() || !storing()) { return; }
     for (var k = 0u; k < contact_count[i]; k++) {
         let slot = i * MAX_CONTACTS + k;
-        if (touching[slot] != 0u) { insert(i, contact_j[slot], hist_in[slot]); }
+        if (touching[slot] != 0u) {
+            insert(ids[i], partner_key(contact_j[slot]), hist_in[slot], i);
+        }
     }
 }

@@ -122,6 +122,7 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("C_HALT_ID", c::HALT_ID as f64),
         ("C_LISTS", c::LISTS as f64),
         ("C_REBUILDS", c::REBUILDS as f64),
+        ("C_INACTIVE", c::INACTIVE as f64),
         ("C_BLOCKED", c::BLOCKED as f64),
         ("REBUILD", c::REBUILD as f64),
         ("TABLE_CURRENT", c::TABLE_CURRENT as f64),

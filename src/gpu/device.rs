@@ -17,7 +17,10 @@ pub enum BackendChoice {
 }
 
 /// Storage buffers bound at once by the largest kernel (see `shaders/common.wgsl`).
-pub const STORAGE_BUFFERS_NEEDED: u32 = 22;
+pub const STORAGE_BUFFERS_NEEDED: u32 = 25;
+/// Every buffer bound at once by the largest kernel: the storage buffers and the uniform
+/// Params.
+pub const BUFFERS_NEEDED: u32 = STORAGE_BUFFERS_NEEDED + 1;
 
 #[derive(Debug, thiserror::Error)]
 pub enum DeviceError {
@@ -58,6 +61,12 @@ fn unsuitable(adapter: &wgpu::Adapter) -> Option<String> {
         return Some(format!(
             "it allows {} storage buffers per shader stage, talus needs {}",
             l.max_storage_buffers_per_shader_stage, STORAGE_BUFFERS_NEEDED
+        ));
+    }
+    if l.max_buffers_and_acceleration_structures_per_shader_stage < BUFFERS_NEEDED {
+        return Some(format!(
+            "it allows {} buffers per shader stage, talus needs {}",
+            l.max_buffers_and_acceleration_structures_per_shader_stage, BUFFERS_NEEDED
         ));
     }
     None
@@ -112,6 +121,7 @@ impl Gpu {
         // particles need more than WebGPU's defaults.
         let limits = wgpu::Limits {
             max_storage_buffers_per_shader_stage: STORAGE_BUFFERS_NEEDED,
+            max_buffers_and_acceleration_structures_per_shader_stage: BUFFERS_NEEDED,
             max_storage_buffer_binding_size: have.max_storage_buffer_binding_size,
             max_buffer_size: have.max_buffer_size,
             max_compute_workgroups_per_dimension: have.max_compute_workgroups_per_dimension,

@@ -80,6 +80,15 @@ pub const MODULES: &[ModuleSource] = &[
         ],
     },
     ModuleSource {
+        name: "permute",
+        parts: &[
+            COMMON,
+            POSITION,
+            ORIENTATION,
+            include_str!("../../shaders/permute.wgsl"),
+        ],
+    },
+    ModuleSource {
         name: "find_contacts",
         parts: &[
             COMMON,
@@ -181,6 +190,8 @@ pub enum Kernel {
     ScanAdd0,
     ClearCursor,
     Scatter,
+    PermuteGather,
+    PermuteStore,
     FindContacts,
     GatherHistory,
     ContactForces,
@@ -194,7 +205,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 24] = [
+    pub const ALL: [Kernel; 26] = [
         Kernel::InsertCheck,
         Kernel::InsertPlace,
         Kernel::Predict,
@@ -209,6 +220,8 @@ impl Kernel {
         Kernel::ScanAdd0,
         Kernel::ClearCursor,
         Kernel::Scatter,
+        Kernel::PermuteGather,
+        Kernel::PermuteStore,
         Kernel::FindContacts,
         Kernel::GatherHistory,
         Kernel::ContactForces,
@@ -238,6 +251,8 @@ impl Kernel {
             Kernel::ScanAdd0 => ("prefix_sum", "scan_add0"),
             Kernel::ClearCursor => ("scatter", "clear_cursor"),
             Kernel::Scatter => ("scatter", "scatter"),
+            Kernel::PermuteGather => ("permute", "permute_gather"),
+            Kernel::PermuteStore => ("permute", "permute_store"),
             Kernel::FindContacts => ("find_contacts", "find_contacts"),
             Kernel::GatherHistory => ("gather_history", "gather_history"),
             Kernel::ContactForces => ("contact_forces", "contact_forces"),
@@ -253,7 +268,7 @@ impl Kernel {
 }
 
 /// Storage bindings of group 0 (binding 0 is the uniform Params) and of group 1.
-pub const GROUP0_STORAGE: u32 = 20;
+pub const GROUP0_STORAGE: u32 = 24;
 pub const GROUP1_STORAGE: u32 = 1;
 
 fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {

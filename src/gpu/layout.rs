@@ -38,7 +38,9 @@ pub mod control {
     pub const REMOVED: u32 = 8;
     /// How many times the device built the lists (`C_REBUILDS`).
     pub const REBUILDS: usize = 7;
-    pub const BLOCKED: usize = 8;
+    /// Inactive particles counted at a rebuild (`C_INACTIVE`).
+    pub const INACTIVE: usize = 9;
+    pub const BLOCKED: usize = 10;
     pub const HALT_OVERLAP: u32 = 1;
     pub const HALT_NOT_FINITE: u32 = 2;
     pub const HALT_CONTACTS_FULL: u32 = 4;
@@ -92,6 +94,8 @@ pub struct Params {
     pub inv_unit: f32,
     /// The neighbour lists' skin (length units).
     pub skin: f32,
+    /// 1: sort the particles in memory by cell at every rebuild (permute.wgsl).
+    pub reorder: u32,
 }
 
 /// Dynamic state of one particle: q[0] = (rem_x, rem_z, rem_θ, 0) and the scaled Gear
@@ -250,7 +254,8 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 scan_offset2,
                 unit,
                 inv_unit,
-                skin
+                skin,
+                reorder
             ]
         ),
         fields!(

@@ -111,7 +111,21 @@ struct Buffers {
     sources: wgpu::Buffer,
     candidates: wgpu::Buffer,
     corners: wgpu::Buffer,
+    /// Each memory slot's particle id, and the particles on their way to a new order.
+    ids: wgpu::Buffer,
+    state_next: wgpu::Buffer,
+    props_next: wgpu::Buffer,
+    ids_next: wgpu::Buffer,
     table: wgpu::Buffer,
+}
+
+/// Per-slot values of the device put in id order (`ids`: each slot's id).
+fn by_id<T: Copy>(ids: &[u32], slots: Vec<T>) -> Vec<T> {
+    let mut out = slots.clone();
+    for (&id, v) in ids.iter().zip(slots) {
+        out[id as usize] = v;
+    }
+    out
 }
 
 /// The source bookkeeping of the host: where each source stood at upload.
@@ -354,6 +368,7 @@ impl GpuSimulation {
             unit: position::unit(cell_size) as f32,
             inv_unit: (1.0 / position::unit(cell_size)) as f32,
             skin: skin as f32,
+            reorder: 1,
             ..Default::default()
         };
         law_params(law, &mut params);
@@ -504,6 +519,13 @@ impl GpuSimulation {
                     c
                 }),
             ),
+            ids: init(
+                "ids",
+                bytemuck::cast_slice(&(0..n_cap).collect::<Vec<u32>>()),
+            ),
+            state_next: zeroed("state_next", n * size_of::<State>() as u64),
+            props_next: zeroed("props_next", n * size_of::<Props>() as u64),
+            ids_next: zeroed("ids_next", n * 4),
             table: init("springs", bytemuck::cast_slice(&table)),
         };
         let pipelines = Pipelines::new(dev, matches!(sim.law, ContactLaw::OverlapArea(_)));
@@ -530,6 +552,10 @@ impl GpuSimulation {
             &b.sources,
             &b.candidates,
             &b.corners,
+            &b.ids,
+            &b.state_next,
+            &b.props_next,
+            &b.ids_next,
         ];
         let entries0: Vec<_> = group0_buffers
             .iter()
@@ -701,6 +727,8 @@ impl GpuSimulation {
             self.encode_kernel(pass, k);
         }
         for k in [
+            Kernel::PermuteGather,
+            Kernel::PermuteStore,
             Kernel::FindContacts,
             Kernel::GatherHistory,
             Kernel::ContactForces,
@@ -826,6 +854,12 @@ impl GpuSimulation {
                     &self.buffers.props,
                     (live * size_of::<Props>()) as u64,
                     bytemuck::cast_slice(&pr[..]),
+                );
+                // Ids are never reused: the new particle's is the number so far.
+                q.write_buffer(
+                    &self.buffers.ids,
+                    (live * 4) as u64,
+                    bytemuck::bytes_of(&(live as u32)),
                 );
                 if !corners.is_empty() {
                     q.write_buffer(
@@ -976,40 +1010,46 @@ impl GpuSimulation {
         for (k, (b, r)) in self.sources.iter().zip(&rows).enumerate() {
             self.sim.sources[k] = source::advanced(&b.spec, &b.state, r.inserted);
         }
-        // This step's contacts, in the CPU's order (by i, then j; walls last).
+        // This step's contacts, in the CPU's order (by i, then j, ids; walls last).
         let m = MAX_CONTACTS as usize;
+        let ids: Vec<u32> = self.read_buffer(&self.buffers.ids, 0, live);
+        let key = |j: u32| if j >= WALL_BASE { j } else { ids[j as usize] };
         let count: Vec<u32> = self.read_buffer(&self.buffers.contact_count, 0, live);
         let js: Vec<u32> = self.read_buffer(&self.buffers.contact_j, 0, live * m);
         let outs: Vec<ContactOut> = self.read_buffer(&self.buffers.contact_out, 0, live * m);
         let touching: Vec<u32> = self.read_buffer(&self.buffers.touching, 0, live * m);
-        let mut pairs = Vec::new();
-        let mut contacts = Vec::new();
+        let mut listed = Vec::new();
         // Every contact as the device computed it: its force, normal and contact point
         // (relative to i's centre), converted exactly from f32 (issue 19).
         let parts = &self.sim.particles;
-        for i in 0..live {
+        for s in 0..live {
             // The lists' candidates that touch: the contacts.
-            for k in (0..count[i] as usize).filter(|&k| touching[i * m + k] != 0) {
-                let j = js[i * m + k];
-                let o = outs[i * m + k];
-                let p = parts.position(i);
+            for k in (0..count[s] as usize).filter(|&k| touching[s * m + k] != 0) {
+                let (i, j) = (ids[s], key(js[s * m + k]));
+                let o = outs[s * m + k];
+                let p = parts.position(i as usize);
                 let arm = [o.geo[2] as f64, o.geo[3] as f64];
-                pairs.push(Pair { i: i as u32, j });
-                contacts.push(ContactForce {
-                    force: [o.ft[0] as f64, o.ft[1] as f64],
-                    // contact_out holds the torque on j; ContactForce the torque of F
-                    // about j's centre.
-                    torque: [o.ft[2] as f64, -(o.ft[3] as f64)],
-                    point: [p[0] + arm[0], p[1] + arm[1]],
-                    arm,
-                    n: [o.geo[0] as f64, o.geo[1] as f64],
-                    f_n: o.info[0] as f64,
-                    f_t: o.info[1] as f64,
-                    overlap: o.info[2] as f64,
-                    energy: o.info[3] as f64,
-                });
+                let pair = Pair { i, j };
+                listed.push((
+                    pair,
+                    ContactForce {
+                        force: [o.ft[0] as f64, o.ft[1] as f64],
+                        // contact_out holds the torque on j; ContactForce the torque of F
+                        // about j's centre.
+                        torque: [o.ft[2] as f64, -(o.ft[3] as f64)],
+                        point: [p[0] + arm[0], p[1] + arm[1]],
+                        arm,
+                        n: [o.geo[0] as f64, o.geo[1] as f64],
+                        f_n: o.info[0] as f64,
+                        f_t: o.info[1] as f64,
+                        overlap: o.info[2] as f64,
+                        energy: o.info[3] as f64,
+                    },
+                ));
             }
         }
+        listed.sort_by_key(|(p, _)| (p.i, p.j));
+        let (pairs, contacts) = listed.into_iter().unzip();
         self.sim.pairs = pairs;
         self.sim.contacts = contacts;
         self.sim.device_state = Some(ds);
@@ -1020,14 +1060,16 @@ impl GpuSimulation {
     /// The exact device state (for checkpoints).
     pub fn device_state(&self) -> DeviceState {
         let live = self.read_control()[control::LIVE] as usize;
-        let mut states: Vec<State> = self.read_buffer(&self.buffers.state, 0, live);
+        // In id order, whatever the memory order on the device.
+        let ids: Vec<u32> = self.read_buffer(&self.buffers.ids, 0, live);
+        let mut states: Vec<State> = by_id(&ids, self.read_buffer(&self.buffers.state, 0, live));
         // Where each particle was at the last rebuild belongs to the lists, not to the
         // state: an upload rebuilds them (and a resumed run may rebuild on other steps).
         for s in &mut states {
             s.listed_anchor = 0;
             s.listed_frac = [0; 2];
         }
-        let props = self.read_buffer(&self.buffers.props, 0, live);
+        let props = by_id(&ids, self.read_buffer(&self.buffers.props, 0, live));
         let cap = self.params.table_mask as usize + 1;
         self.flush_table();
         let table: Vec<Entry> = self.read_buffer(&self.buffers.table, 0, cap);
@@ -1047,8 +1089,20 @@ impl GpuSimulation {
         let (s, pr) = to_device(p, self.origin, self.params.cell_size);
         let s_buf = self.buffers.state.clone();
         let p_buf = self.buffers.props.clone();
+        let ids_buf = self.buffers.ids.clone();
         self.write_buffer(&s_buf, &s);
         self.write_buffer(&p_buf, &pr);
+        self.write_buffer(&ids_buf, &(0..s.len() as u32).collect::<Vec<_>>());
+    }
+
+    /// Whether rebuilds sort the particles in memory by cell (default: yes). No result
+    /// depends on it (tests compare both).
+    pub fn set_reorder(&mut self, reorder: bool) {
+        self.params.reorder = reorder as u32;
+        let params = self.params;
+        self.gpu
+            .queue
+            .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&params));
     }
 
     /// Makes the spring table hold the springs of the current lists (those of the
@@ -1122,6 +1176,7 @@ impl GpuSimulation {
             "cell_count" => &b.cell_count,
             "cell_start" => &b.cell_start,
             "sorted" => &b.sorted,
+            "ids" => &b.ids,
             "contact_j" => &b.contact_j,
             "contact_count" => &b.contact_count,
             "touching" => &b.touching,
