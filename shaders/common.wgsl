@@ -128,16 +128,6 @@ struct Props {
     shape: vec2<u32>,   // polygon corners: first index in `corners`, count (0: disk)
 };
 
-struct ContactOut {
-    // (f_x, f_z) on i, torque on i, torque on j
-    ft: vec4<f32>,
-    // f_n, f_t, overlap, elastic energy
-    info: vec4<f32>,
-    // the geometry the force was computed with: the normal (n_x, n_z) from j to i and
-    // the contact point relative to i's centre (for outputs; issue 19)
-    geo: vec4<f32>,
-};
-
 // A segment a-b; both end points in fixed point, ab = b - a in length units.
 struct Wall {
     a_anchor: vec2<i32>,
@@ -199,7 +189,10 @@ struct Candidate {
 @group(0) @binding(12) var<storage, read_write> hist_in: array<f32>;
 // Whether each candidate of the lists touched at the last evaluation (1) or not (0).
 @group(0) @binding(13) var<storage, read_write> touching: array<u32>;
-@group(0) @binding(14) var<storage, read_write> contact_out: array<ContactOut>;
+// Each candidate's result, one array per use so that each takes 16 bytes per slot (256
+// per particle: 5.2e5 particles in lavapipe's 128 MiB binding) and the reduction reads
+// only what it sums: (f_x, f_z) on i, torque on i, torque on j.
+@group(0) @binding(14) var<storage, read_write> contact_ft: array<vec4<f32>>;
 @group(0) @binding(15) var<storage, read_write> force: array<vec4<f32>>;
 @group(0) @binding(16) var<storage, read_write> walls: array<Wall>;
 @group(0) @binding(17) var<storage, read_write> control: array<atomic<u32>>;
@@ -217,6 +210,11 @@ struct Candidate {
 @group(0) @binding(22) var<storage, read_write> state_next: array<State>;
 @group(0) @binding(23) var<storage, read_write> props_next: array<Props>;
 @group(0) @binding(24) var<storage, read_write> ids_next: array<u32>;
+// For outputs only (written for the candidates that touch, never read by the kernels):
+// (f_n, f_t, overlap, elastic energy) and the geometry the force was computed with, the
+// normal (n_x, n_z) from j to i and the contact point relative to i's centre (issue 19).
+@group(0) @binding(25) var<storage, read_write> contact_info: array<vec4<f32>>;
+@group(0) @binding(26) var<storage, read_write> contact_geo: array<vec4<f32>>;
 // The spring table keyed by pair: touched only at a rebuild of the lists, which stores
 // the old lists' springs into it and gathers the new lists' from it (issue 13).
 @group(1) @binding(0) var<storage, read_write> table: array<Entry>;

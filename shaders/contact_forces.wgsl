@@ -94,7 +94,7 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
             touches = disks_touch(i, j, g);
         }
         if (!touches) {
-            contact_out[slot] = ContactOut(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+            contact_ft[slot] = vec4<f32>(0.0);
             hist_in[slot] = 0.0;
             touching[slot] = 0u;
             continue;
@@ -112,9 +112,9 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
                                  m12, mass, hist_in[slot], params.dt);
         let res = evaluate(input);
         let f = res.f_n * g.n + res.f_t * t;
-        contact_out[slot] = ContactOut(vec4<f32>(f, cross2(l1, f), -cross2(l2, f)),
-                                       vec4<f32>(res.f_n, res.f_t, g.delta, res.energy),
-                                       vec4<f32>(g.n, l1));
+        contact_ft[slot] = vec4<f32>(f, cross2(l1, f), -cross2(l2, f));
+        contact_info[slot] = vec4<f32>(res.f_n, res.f_t, g.delta, res.energy);
+        contact_geo[slot] = vec4<f32>(g.n, l1);
         // In place: the slot's spring is the list's history from step to step.
         hist_in[slot] = res.history;
         let finite = abs(f.x) <= 3.0e38 && abs(f.y) <= 3.0e38;

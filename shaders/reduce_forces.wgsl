@@ -25,12 +25,12 @@ fn reduce_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         keys[k] = key;
     }
     for (var a = 0u; a < nd; a++) {
-        let ft = contact_out[slots[a]].ft;
+        let ft = contact_ft[slots[a]];
         acc -= vec3<f32>(ft.xy, 0.0);
         acc.z += ft.w;
     }
     for (var k = 0u; k < contact_count[p]; k++) {
-        let ft = contact_out[p * MAX_CONTACTS + k].ft;
+        let ft = contact_ft[p * MAX_CONTACTS + k];
         acc += ft.xyz;
     }
     force[p] = vec4<f32>(acc, 0.0);

@@ -17,7 +17,7 @@ pub enum BackendChoice {
 }
 
 /// Storage buffers bound at once by the largest kernel (see `shaders/common.wgsl`).
-pub const STORAGE_BUFFERS_NEEDED: u32 = 25;
+pub const STORAGE_BUFFERS_NEEDED: u32 = 27;
 /// Every buffer bound at once by the largest kernel: the storage buffers and the uniform
 /// Params.
 pub const BUFFERS_NEEDED: u32 = STORAGE_BUFFERS_NEEDED + 1;

@@ -268,7 +268,7 @@ impl Kernel {
 }
 
 /// Storage bindings of group 0 (binding 0 is the uniform Params) and of group 1.
-pub const GROUP0_STORAGE: u32 = 24;
+pub const GROUP0_STORAGE: u32 = 26;
 pub const GROUP1_STORAGE: u32 = 1;
 
 fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {

@@ -130,6 +130,8 @@ pub struct Props {
     pub shape: [u32; 2],
 }
 
+/// One candidate's result as the host reads it: its slot of the three arrays
+/// `contact_ft`, `contact_info` and `contact_geo` (common.wgsl), 16 bytes each.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct ContactOut {
@@ -276,7 +278,6 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 shape
             ]
         ),
-        fields!(ContactOut, "ContactOut", [ft, info, geo]),
         fields!(
             Wall,
             "Wall",

@@ -104,7 +104,10 @@ struct Buffers {
     down_count: wgpu::Buffer,
     hist_in: wgpu::Buffer,
     touching: wgpu::Buffer,
-    contact_out: wgpu::Buffer,
+    /// Each candidate's result: what the reduction sums, and for outputs only.
+    contact_ft: wgpu::Buffer,
+    contact_info: wgpu::Buffer,
+    contact_geo: wgpu::Buffer,
     force: wgpu::Buffer,
     walls: wgpu::Buffer,
     control: wgpu::Buffer,
@@ -393,7 +396,7 @@ impl GpuSimulation {
         let n = n_cap as u64;
         let m = MAX_CONTACTS as u64;
         check("particle state", n * size_of::<State>() as u64)?;
-        check("contact", n * m * size_of::<ContactOut>() as u64)?;
+        check("contact", n * m * 16)?;
         check("spring table", table_cap * size_of::<Entry>() as u64)?;
         check("cell", cells * 4)?;
 
@@ -500,7 +503,9 @@ impl GpuSimulation {
             down_count: zeroed("down_count", n * 4),
             hist_in: zeroed("hist_in", n * m * 4),
             touching: zeroed("touching", n * m * 4),
-            contact_out: zeroed("contact_out", n * m * size_of::<ContactOut>() as u64),
+            contact_ft: zeroed("contact_ft", n * m * 16),
+            contact_info: zeroed("contact_info", n * m * 16),
+            contact_geo: zeroed("contact_geo", n * m * 16),
             force: zeroed("force", n * 16),
             walls: init("walls", bytemuck::cast_slice(&walls)),
             control: init("control", bytemuck::cast_slice(&control)),
@@ -545,7 +550,7 @@ impl GpuSimulation {
             &b.down_count,
             &b.hist_in,
             &b.touching,
-            &b.contact_out,
+            &b.contact_ft,
             &b.force,
             &b.walls,
             &b.control,
@@ -556,6 +561,8 @@ impl GpuSimulation {
             &b.state_next,
             &b.props_next,
             &b.ids_next,
+            &b.contact_info,
+            &b.contact_geo,
         ];
         let entries0: Vec<_> = group0_buffers
             .iter()
@@ -1016,7 +1023,7 @@ impl GpuSimulation {
         let key = |j: u32| if j >= WALL_BASE { j } else { ids[j as usize] };
         let count: Vec<u32> = self.read_buffer(&self.buffers.contact_count, 0, live);
         let js: Vec<u32> = self.read_buffer(&self.buffers.contact_j, 0, live * m);
-        let outs: Vec<ContactOut> = self.read_buffer(&self.buffers.contact_out, 0, live * m);
+        let outs = self.read_contact_out(live * m);
         let touching: Vec<u32> = self.read_buffer(&self.buffers.touching, 0, live * m);
         let mut listed = Vec::new();
         // Every contact as the device computed it: its force, normal and contact point
@@ -1201,7 +1208,13 @@ impl GpuSimulation {
     }
 
     pub fn read_contact_out(&self, count: usize) -> Vec<ContactOut> {
-        self.read_buffer(&self.buffers.contact_out, 0, count)
+        let b = &self.buffers;
+        let ft: Vec<[f32; 4]> = self.read_buffer(&b.contact_ft, 0, count);
+        let info: Vec<[f32; 4]> = self.read_buffer(&b.contact_info, 0, count);
+        let geo: Vec<[f32; 4]> = self.read_buffer(&b.contact_geo, 0, count);
+        (ft.into_iter().zip(info).zip(geo))
+            .map(|((ft, info), geo)| ContactOut { ft, info, geo })
+            .collect()
     }
 }
 
