@@ -198,6 +198,12 @@ pub fn describe() -> String {
             s,
             "      features used: none beyond core WebGPU compute (f32, u32 atomics)"
         );
+        let binding = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
+        let _ = writeln!(
+            s,
+            "      largest scene the GPU path holds here: {} particles",
+            crate::gpu::max_particles(binding)
+        );
         if let Some(why) = unsuitable(a) {
             let _ = writeln!(s, "      unsuitable: {why}");
         }

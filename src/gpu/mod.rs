@@ -202,6 +202,41 @@ pub enum GpuError {
 /// hold one element of the largest struct the shaders bind.
 pub const MIN_BUFFER: u64 = 256;
 
+/// The largest buffers that grow with the particle count n, and their sizes in bytes:
+/// what an adapter's binding limit must hold (checked before a run).
+pub fn particle_buffers(n: u64) -> [(&'static str, u64); 3] {
+    let table_cap = table_capacity(n);
+    [
+        ("particle state", n * size_of::<State>() as u64),
+        ("contact", n * MAX_CONTACTS as u64 * 16),
+        ("spring table", table_cap * size_of::<Entry>() as u64),
+    ]
+}
+
+/// Slots of the spring table for n particles: a power of two (the hash's mask), about
+/// eight per particle (a dense packing has ~2 contacts per particle as the lower id: the
+/// table stays about a quarter full, and probes stay short).
+fn table_capacity(n: u64) -> u64 {
+    (8 * n).next_power_of_two().max(64)
+}
+
+/// The most particles the GPU path holds where a buffer binds at most `binding` bytes:
+/// every buffer of `particle_buffers` within it, and one thread per particle in a
+/// dispatch of at most `MAX_WORKGROUPS` workgroups (`talus info` prints it).
+pub fn max_particles(binding: u64) -> u64 {
+    let fits = |n: u64| particle_buffers(n).iter().all(|&(_, b)| b <= binding);
+    let (mut lo, mut hi) = (0, MAX_WORKGROUPS * WG as u64);
+    if fits(hi) {
+        return hi;
+    }
+    // fits(lo) and not fits(hi): the sizes grow with n.
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        if fits(mid) { lo = mid } else { hi = mid }
+    }
+    lo
+}
+
 fn ceil_div(a: u64, b: u64) -> u64 {
     a.div_ceil(b)
 }
@@ -332,7 +367,7 @@ impl GpuSimulation {
         }
         let n_now = sim.particles.len() as u32;
         let n_cap = (n_now + candidates.len() as u32 + layered_count).max(1);
-        let table_cap = (8 * n_cap as u64).next_power_of_two().max(64);
+        let table_cap = table_capacity(n_cap as u64);
         let cells = bucket_count(&grid, n_cap);
 
         let law = &sim.law;
@@ -392,13 +427,12 @@ impl GpuSimulation {
             .into());
         }
 
-        let check = |what: &str, bytes: u64| gpu.check_buffer(what, bytes);
+        for (what, bytes) in particle_buffers(n_cap as u64) {
+            gpu.check_buffer(what, bytes)?;
+        }
+        gpu.check_buffer("cell", cells * 4)?;
         let n = n_cap as u64;
         let m = MAX_CONTACTS as u64;
-        check("particle state", n * size_of::<State>() as u64)?;
-        check("contact", n * m * 16)?;
-        check("spring table", table_cap * size_of::<Entry>() as u64)?;
-        check("cell", cells * 4)?;
 
         let dev = &gpu.device;
         let storage = wgpu::BufferUsages::STORAGE
@@ -1445,9 +1479,31 @@ fn law_params(law: &ContactLaw, p: &mut Params) {
 }
 
 #[cfg(test)]
-mod bucket_tests {
+mod tests {
     use super::*;
     use crate::cell_list::Grid;
+
+    #[test]
+    fn the_largest_scene_is_what_the_bindings_and_one_dispatch_hold() {
+        // lavapipe binds 128 MiB: the candidates' result arrays (256 B per particle)
+        // and the spring table (16 B per slot, a power of two) stop at 2^19.
+        let lavapipe = 128 << 20;
+        assert_eq!(max_particles(lavapipe), 1 << 19);
+        assert!(
+            particle_buffers(1 << 19)
+                .iter()
+                .all(|&(_, b)| b <= lavapipe)
+        );
+        assert!(
+            particle_buffers((1 << 19) + 1)
+                .iter()
+                .any(|&(_, b)| b > lavapipe)
+        );
+        // NVIDIA-class 2 GiB bindings: one dispatch of 65 535 workgroups of 64 is the
+        // limit, above the 4·10⁶ disks issue 14 asks for.
+        assert_eq!(max_particles(2 << 30), MAX_WORKGROUPS * WG as u64);
+        assert!(max_particles(2 << 30) >= 4_000_000);
+    }
 
     #[test]
     fn a_dense_grid_is_its_own_buckets_and_a_wide_one_spreads_over_them() {
