@@ -484,6 +484,41 @@ fn gpu_results_do_not_depend_on_the_memory_order() {
 }
 
 #[test]
+fn a_gpu_halt_names_its_step_while_later_batches_are_in_flight() {
+    // Issue 14 item 3: `advance` keeps a second batch queued while the host reads the
+    // first one's control words. A pour whose first landings break a tight overlap
+    // bound: one long advance (the halting batch followed by one already submitted)
+    // stops at the same step, with the same message and the same state, as steps taken
+    // one submission at a time.
+    let scene = || {
+        let mut s = quick_pour();
+        s.limits.max_overlap = 0.002;
+        s
+    };
+    let Some(mut pipelined) = gpu_sim("a_gpu_halt_names_its_step", scene()) else {
+        return;
+    };
+    let long = pipelined.advance(20_000).expect_err("the pour diverges");
+    let mut single = gpu_sim("halt", scene()).unwrap();
+    let one_by_one = loop {
+        if let Err(e) = single.advance(1) {
+            break e;
+        }
+    };
+    assert_eq!(long.to_string(), one_by_one.to_string());
+    assert_eq!(pipelined.step(), single.step(), "the halt's step");
+    assert!(
+        pipelined.step() > 3 * talus::gpu::STEPS_PER_SUBMIT,
+        "the halt comes several batches in (step {})",
+        pipelined.step()
+    );
+    assert!(
+        pipelined.device_state() == single.device_state(),
+        "the state at the halt"
+    );
+}
+
+#[test]
 fn gpu_runs_are_bitwise_reproducible_and_resume_bitwise() {
     assert_gpu_bitwise("gpu_runs_are_bitwise_reproducible", quick_pour, 6000);
 }

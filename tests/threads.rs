@@ -78,6 +78,15 @@ fn assert_same_state(a: &Simulation, b: &Simulation, what: &str) {
     assert_eq!(a.spring_table(), b.spring_table(), "{what}: springs");
 }
 
+/// f run on a pool of `threads` threads.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
 #[test]
 fn results_do_not_depend_on_the_skin() {
     // History lives in the candidates' slots between rebuilds and moves with its pair at
@@ -115,13 +124,7 @@ fn results_do_not_depend_on_the_thread_count() {
         ("packing", serde_json::to_value(packing).unwrap(), 300),
     ];
     for (name, v, steps) in scenes {
-        let on = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-                .install(|| run(&v, steps))
-        };
+        let on = |threads: usize| on_threads(threads, || run(&v, steps));
         let one = on(1);
         for threads in [2, 3] {
             assert_same(&one, &on(threads), &format!("{name}, {threads} threads"));
@@ -162,24 +165,20 @@ fn results_do_not_depend_on_the_memory_order() {
         let plain = run(&v, steps);
         assert_eq!(plain.reorders, 0, "plain steps keep the id order");
         for threads in [1, 2] {
-            let sorted = rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .unwrap()
-                .install(|| {
-                    let mut s = common::sim(&v);
-                    let mut done = 0;
-                    // Advances of uneven lengths: some end right after a reorder.
-                    for chunk in [1, 7, 100, 256].into_iter().cycle() {
-                        let k = chunk.min(steps - done);
-                        s.advance(k as u64).unwrap();
-                        done += k;
-                        if done == steps {
-                            break;
-                        }
+            let sorted = on_threads(threads, || {
+                let mut s = common::sim(&v);
+                let mut done = 0;
+                // Advances of uneven lengths: some end right after a reorder.
+                for chunk in [1, 7, 100, 256].into_iter().cycle() {
+                    let k = chunk.min(steps - done);
+                    s.advance(k as u64).unwrap();
+                    done += k;
+                    if done == steps {
+                        break;
                     }
-                    s
-                });
+                }
+                s
+            });
             assert!(
                 sorted.reorders >= reorders,
                 "{name}: only {} rebuilds changed the memory order",
@@ -213,17 +212,13 @@ fn an_advance_is_its_steps_through_insertions_escapes_and_a_divergence() {
         plain.lost
     );
     for threads in [1, 2] {
-        let advanced = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| {
-                let mut s = common::sim(&v);
-                for chunk in [3, 50, 999, 64, 4884] {
-                    s.advance(chunk).unwrap();
-                }
-                s
-            });
+        let advanced = on_threads(threads, || {
+            let mut s = common::sim(&v);
+            for chunk in [3, 50, 999, 64, 4884] {
+                s.advance(chunk).unwrap();
+            }
+            s
+        });
         assert_same(
             &plain,
             &advanced,

@@ -131,6 +131,18 @@ fn by_id<T: Copy>(ids: &[u32], slots: Vec<T>) -> Vec<T> {
     out
 }
 
+/// Batches of steps in flight at most (`GpuSimulation::advance`): the host encodes and
+/// submits one while the device runs the other.
+pub const BATCHES_IN_FLIGHT: usize = 2;
+
+/// A submitted batch of steps: its submission and the staging buffer its control words
+/// are copied to.
+struct Batch {
+    staging: wgpu::Buffer,
+    index: wgpu::SubmissionIndex,
+    steps: u64,
+}
+
 /// The source bookkeeping of the host: where each source stood at upload.
 struct SourceBase {
     spec: PointSource,
@@ -795,48 +807,106 @@ impl GpuSimulation {
         self.live < self.n_cap && !self.sources.is_empty()
     }
 
-    /// Advances `steps` steps, `STEPS_PER_SUBMIT` per submission; after each submission
-    /// the control words are read to catch a divergence.
+    /// Advances `steps` steps, `STEPS_PER_SUBMIT` per submission. Submissions are
+    /// pipelined (issue 14 item 3): each batch copies the control words into its own
+    /// staging buffer, and the host reads them only once the next batch is submitted, so
+    /// the device always has work queued and the host never waits on an idle device. A
+    /// halt stops every later kernel on the device at once (each returns when `halted`),
+    /// so a batch submitted after the halting one changes nothing, and the halt still
+    /// names its step.
     pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
-        let mut left = steps;
         let sources_left = self.sources_left();
-        while left > 0 {
-            let mut k = left.min(STEPS_PER_SUBMIT);
-            // Submissions stop where a layered row is due; the host lays it.
-            if let Some(due) = self.next_layered_step() {
-                if due == self.step {
-                    self.place_layered_rows();
-                } else {
-                    k = k.min(due - self.step);
+        let mut left = steps;
+        let mut in_flight: std::collections::VecDeque<Batch> = Default::default();
+        // The step the device reaches once the batches in flight are done.
+        let mut planned = self.step;
+        while left > 0 || !in_flight.is_empty() {
+            if left > 0 && in_flight.len() < BATCHES_IN_FLIGHT {
+                let mut k = left.min(STEPS_PER_SUBMIT);
+                // Submissions stop where a layered row is due; the host lays it once the
+                // device has caught up.
+                match self.next_layered_step(planned) {
+                    Some(due) if due == planned && in_flight.is_empty() => {
+                        self.place_layered_rows();
+                        // The next row may be due within this batch.
+                        continue;
+                    }
+                    Some(due) if due == planned => k = 0,
+                    Some(due) => k = k.min(due - planned),
+                    None => {}
+                }
+                if k > 0 {
+                    in_flight.push_back(self.submit_batch(k, sources_left));
+                    planned += k;
+                    left -= k;
+                    continue;
                 }
             }
-            let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-            {
-                let mut pass = enc.begin_compute_pass(&Default::default());
-                pass.set_bind_group(0, &self.group0, &[]);
-                pass.set_bind_group(1, &self.group1, &[]);
-                for _ in 0..k {
-                    self.encode_step(&mut pass, sources_left);
-                }
-            }
-            self.gpu.queue.submit([enc.finish()]);
-            self.submissions.set(self.submissions.get() + 1);
-            self.synced = false;
-            let c = self.read_control();
+            let batch = in_flight.pop_front().expect("a batch in flight");
+            let done = batch.steps;
+            let c = self.wait_for(batch);
             self.live = c[control::LIVE];
             self.lost_now = c[control::LOST] as u64;
             if c[control::HALT] != 0 {
+                // The later batches ran as no-ops; let them finish first.
+                for b in in_flight.drain(..) {
+                    self.wait_for(b);
+                }
                 return Err(self.halt_cause(&c));
             }
-            self.step += k;
-            left -= k;
+            self.step += done;
         }
         Ok(())
     }
 
-    /// The first step, from now on, at which a layered block lays its next row (as the
+    /// Encodes and submits `k` steps, with a copy of the control words at their end.
+    fn submit_batch(&mut self, k: u64, sources_left: bool) -> Batch {
+        let words = control::BLOCKED;
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("control readback"),
+            size: (words * 4) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            pass.set_bind_group(0, &self.group0, &[]);
+            pass.set_bind_group(1, &self.group1, &[]);
+            for _ in 0..k {
+                self.encode_step(&mut pass, sources_left);
+            }
+        }
+        enc.copy_buffer_to_buffer(&self.buffers.control, 0, &staging, 0, (words * 4) as u64);
+        let index = self.gpu.queue.submit([enc.finish()]);
+        staging
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, |r| r.expect("GPU readback failed"));
+        self.submissions.set(self.submissions.get() + 1);
+        self.synced = false;
+        Batch {
+            staging,
+            index,
+            steps: k,
+        }
+    }
+
+    /// Waits until a batch is done and returns the control words it left.
+    fn wait_for(&self, batch: Batch) -> Vec<u32> {
+        self.gpu
+            .device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(batch.index),
+                timeout: None,
+            })
+            .expect("GPU device lost");
+        let view = batch.staging.slice(..).get_mapped_range().expect("mapped");
+        bytemuck::cast_slice::<u8, u32>(&view[..]).to_vec()
+    }
+
+    /// The first step from `from` on at which a layered block lays its next row (as the
     /// CPU path decides it: at the start of the first step with t ≥ its time).
-    fn next_layered_step(&self) -> Option<u64> {
+    fn next_layered_step(&self, from: u64) -> Option<u64> {
         let dt = self.sim.scene.dt;
         self.layered
             .iter()
@@ -846,7 +916,7 @@ impl GpuSimulation {
                     return None;
                 }
                 let due = b.spec.start_time + k as f64 * b.spec.interval;
-                let mut s = ((due / dt).floor() as u64).saturating_sub(1).max(self.step);
+                let mut s = ((due / dt).floor() as u64).saturating_sub(1).max(from);
                 while (s as f64) * dt < due {
                     s += 1;
                 }
