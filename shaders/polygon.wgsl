@@ -110,6 +110,18 @@ fn corner_mean(c: ptr<function, Clip>, b: u32, n: u32) -> vec2<f32> {
     return s / f32(n);
 }
 
+// A circle holding every corner of polygon b of c: their mean (xy) and the largest
+// squared distance from it (z) (overlap.rs `bounding_circle`).
+fn bounding_circle(c: ptr<function, Clip>, b: u32, n: u32) -> vec3<f32> {
+    let m = corner_mean(c, b, n);
+    var r2 = 0.0;
+    for (var k = 0u; k < n; k++) {
+        let x = (*c).v[b][k] - m;
+        r2 = max(r2, dot(x, x));
+    }
+    return vec3<f32>(m, r2);
+}
+
 fn reduced_arm(li: f32, lj: f32, scale: f32) -> f32 {
     let floor = 1.0e-6 * scale;
     let a = max(li, floor);
@@ -302,7 +314,15 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
     }
     first = (first + nq - 1u) % nq;
     var a = corner_at(q, first, h);
+    // After the first two clips the few corners left lie in a small circle: an edge
+    // whose half-plane holds it with room for f32 rounding (1e-4 relative, 1e-5 of r)
+    // leaves every corner where it is, as clipping by it would (overlap.rs `clip_by`).
+    var cap = vec3<f32>(0.0, 0.0, -1.0);
     for (var e = 0u; e < nq; e++) {
+        if (e == 2u && count[cur] > 0u) {
+            let bc = bounding_circle(&c, cur, count[cur]);
+            cap = vec3<f32>(bc.xy, sqrt(bc.z) * (1.0 + 1.0e-4) + 1.0e-5 * r);
+        }
         let k = (first + e) % nq;
         let b = corner_at(q, (k + 1u) % nq, h);
         let m = vec2<f32>(-(b.y - a.y), b.x - a.x);
@@ -313,6 +333,10 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
         // Edges whose half-plane holds all of p's circle change nothing.
         if (centre >= reach) { continue; }
         if (centre <= -reach) { count[cur] = 0u; break; }
+        if (cap.z >= 0.0) {
+            let side = dot(cap.xy - start, m);
+            if (side > 0.0 && side * side > cap.z * cap.z * dot(m, m)) { continue; }
+        }
         count[1u - cur] = clip_lines(&c, cur, count[cur], start, m, Q_LINE + k);
         cur = 1u - cur;
         if (count[cur] == 0u) { break; }
