@@ -1,11 +1,11 @@
 // Stage: boundaries (src/sim.rs `remove_escaped`): a particle whose centre left the
 // domain is deactivated and counted as lost. Also the divergence check on positions,
-// and the step counter that closes every step.
+// and the step counter that closes every step. `leave_domain` runs at the end of the
+// integrators' kernels (`correct`, `kick_drift`), for each active particle once it has
+// moved: one dispatch fewer per step.
 
-@compute @workgroup_size(WG)
-fn boundaries(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= live() || halted() || !is_active(i)) { return; }
+fn leave_domain(i: u32) {
+    if (!is_active(i)) { return; }
     let s = state[i];
     let p = position(s);
     let ok = abs(s.q[0].x) <= 3.0e38 && abs(s.q[0].y) <= 3.0e38 && abs(s.q[0].z) <= 3.0e38;

@@ -22,12 +22,16 @@ fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
 @compute @workgroup_size(WG)
 fn correct(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= live() || halted() || !is_integrated(i)) { return; }
-    // Forces were evaluated at the predicted state, i.e. at time t + dt.
-    let g = gravity_at(f32(atomicLoad(&control[C_STEP]) + 1u));
-    var s = state[i];
-    correct_one(&s, acceleration(i, g));
-    renormalize(&s);
-    renormalize_turn(&s);
-    state[i] = s;
+    if (i >= live() || halted()) { return; }
+    if (is_integrated(i)) {
+        // Forces were evaluated at the predicted state, i.e. at time t + dt.
+        let g = gravity_at(f32(atomicLoad(&control[C_STEP]) + 1u));
+        var s = state[i];
+        correct_one(&s, acceleration(i, g));
+        renormalize(&s);
+        renormalize_turn(&s);
+        state[i] = s;
+    }
+    // The boundaries (boundaries.wgsl; src/sim.rs `remove_escaped`).
+    leave_domain(i);
 }

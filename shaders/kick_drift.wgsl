@@ -9,15 +9,19 @@ fn acceleration(i: u32, g: vec2<f32>) -> vec4<f32> {
 @compute @workgroup_size(WG)
 fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= live() || halted() || !is_integrated(i)) { return; }
-    let g = gravity_at(f32(atomicLoad(&control[C_STEP])));
-    var s = state[i];
-    let a = acceleration(i, g);
-    s.q[1] += a * params.dt * params.dt;
-    turn_by(&s, s.q[1].z);
-    displace(&s, s.q[1].xy);
-    renormalize(&s);
-    renormalize_turn(&s);
-    state[i] = s;
-    rotate_corners(i, s);
+    if (i >= live() || halted()) { return; }
+    if (is_integrated(i)) {
+        let g = gravity_at(f32(atomicLoad(&control[C_STEP])));
+        var s = state[i];
+        let a = acceleration(i, g);
+        s.q[1] += a * params.dt * params.dt;
+        turn_by(&s, s.q[1].z);
+        displace(&s, s.q[1].xy);
+        renormalize(&s);
+        renormalize_turn(&s);
+        state[i] = s;
+        rotate_corners(i, s);
+    }
+    // The boundaries (boundaries.wgsl; src/sim.rs `remove_escaped`).
+    leave_domain(i);
 }

@@ -19,12 +19,16 @@ fn predict_one(s: ptr<function, State>) {
 @compute @workgroup_size(WG)
 fn predict(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
-    if (i >= live() || halted() || !is_integrated(i)) { return; }
-    var s = state[i];
-    predict_one(&s);
-    renormalize(&s);
-    renormalize_turn(&s);
-    state[i] = s;
-    // Forces are evaluated at the predicted state.
-    rotate_corners(i, s);
+    if (i >= live() || halted()) { return; }
+    if (is_integrated(i)) {
+        var s = state[i];
+        predict_one(&s);
+        renormalize(&s);
+        renormalize_turn(&s);
+        state[i] = s;
+        // Forces are evaluated at the predicted state.
+        rotate_corners(i, s);
+    }
+    // The survey of the predicted particle (survey.wgsl; src/sim.rs `survey_with`).
+    survey_one(i);
 }

@@ -16,13 +16,19 @@ fn moved(s: State) -> bool {
     return dot(d, d) > half * half;
 }
 
-@compute @workgroup_size(WG)
-fn survey(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= live() || halted()) { return; }
+// Particle i's part of the survey; Gear's `predict` runs it for each particle once
+// predicted (one dispatch fewer per step), leapfrog's step the kernel below.
+fn survey_one(i: u32) {
     if (params.skin <= 0.0) {
         if (i == 0u) { request_rebuild(); }
         return;
     }
     if (is_active(i) && moved(state[i])) { request_rebuild(); }
+}
+
+@compute @workgroup_size(WG)
+fn survey(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= live() || halted()) { return; }
+    survey_one(i);
 }

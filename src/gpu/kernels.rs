@@ -32,6 +32,7 @@ pub const MODULES: &[ModuleSource] = &[
             POSITION,
             ORIENTATION,
             include_str!("../../shaders/predict.wgsl"),
+            include_str!("../../shaders/survey.wgsl"),
         ],
     },
     ModuleSource {
@@ -145,6 +146,7 @@ pub const MODULES: &[ModuleSource] = &[
             POSITION,
             ORIENTATION,
             include_str!("../../shaders/correct.wgsl"),
+            include_str!("../../shaders/boundaries.wgsl"),
         ],
     },
     ModuleSource {
@@ -154,6 +156,7 @@ pub const MODULES: &[ModuleSource] = &[
             POSITION,
             ORIENTATION,
             include_str!("../../shaders/kick_drift.wgsl"),
+            include_str!("../../shaders/boundaries.wgsl"),
         ],
     },
     ModuleSource {
@@ -200,12 +203,11 @@ pub enum Kernel {
     ReduceForces,
     Correct,
     KickDrift,
-    Boundaries,
     AdvanceClock,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 26] = [
+    pub const ALL: [Kernel; 25] = [
         Kernel::InsertCheck,
         Kernel::InsertPlace,
         Kernel::Predict,
@@ -230,7 +232,6 @@ impl Kernel {
         Kernel::ReduceForces,
         Kernel::Correct,
         Kernel::KickDrift,
-        Kernel::Boundaries,
         Kernel::AdvanceClock,
     ];
 
@@ -261,7 +262,6 @@ impl Kernel {
             Kernel::ReduceForces => ("reduce_forces", "reduce_forces"),
             Kernel::Correct => ("correct", "correct"),
             Kernel::KickDrift => ("kick_drift", "kick_drift"),
-            Kernel::Boundaries => ("boundaries", "boundaries"),
             Kernel::AdvanceClock => ("boundaries", "advance_clock"),
         }
     }

@@ -767,13 +767,19 @@ impl GpuSimulation {
             self.encode_kernel(pass, Kernel::InsertPlace);
         }
         let gear = self.params.integrator == 0;
-        if gear {
-            self.encode_kernel(pass, Kernel::Predict);
-        }
         // The neighbour lists (issue 13): the survey decides whether this step rebuilds
         // them; the stages of a rebuild (the old lists' springs into the table, the cell
         // list, the new lists, their springs from the table) return at once otherwise.
-        for k in [Kernel::Survey, Kernel::ClearTable, Kernel::StoreHistory] {
+        // Gear's prediction surveys each particle it predicts.
+        self.encode_kernel(
+            pass,
+            if gear {
+                Kernel::Predict
+            } else {
+                Kernel::Survey
+            },
+        );
+        for k in [Kernel::ClearTable, Kernel::StoreHistory] {
             self.encode_kernel(pass, k);
         }
         for k in Self::CELL_LIST {
@@ -797,7 +803,7 @@ impl GpuSimulation {
                 Kernel::KickDrift
             },
         );
-        self.encode_kernel(pass, Kernel::Boundaries);
+        // (The integrators' kernels end with the boundaries.)
         self.encode_kernel(pass, Kernel::AdvanceClock);
     }
 
