@@ -1,11 +1,6 @@
 // Stage: Gear corrector (src/integrate/gear.rs `correct`), c0 = 3/20 for
-// velocity-dependent forces (Allen & Tildesley).
-
-
-fn acceleration(i: u32, g: vec2<f32>) -> vec4<f32> {
-    let f = force[i];
-    return vec4<f32>(f.xy / props[i].mass + g, f.z * props[i].inv_inertia, 0.0);
-}
+// velocity-dependent forces (Allen & Tildesley). Each particle's contact forces are summed
+// here as it is corrected (`acceleration`, reduce_forces.wgsl).
 
 fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
     let half_dt2 = 0.5 * params.dt * params.dt;

@@ -1,10 +1,6 @@
 // Stage: leapfrog (src/integrate/leapfrog.rs `kick_drift`), paper 001 eq. 9-12, with
-// q1 = dt v(t - dt/2).
-
-fn acceleration(i: u32, g: vec2<f32>) -> vec4<f32> {
-    let f = force[i];
-    return vec4<f32>(f.xy / props[i].mass + g, f.z * props[i].inv_inertia, 0.0);
-}
+// q1 = dt v(t - dt/2). Each particle's contact forces are summed here as it moves
+// (`acceleration`, reduce_forces.wgsl).
 
 @compute @workgroup_size(WG)
 fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {

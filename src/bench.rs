@@ -28,10 +28,16 @@ pub struct Measurement {
     pub particle_steps_per_second: f64,
     pub steps_per_second: f64,
     pub microseconds_per_step: f64,
-    /// GPU path: compute dispatches and queue submissions (batches of steps and
-    /// readbacks) per step.
+    /// GPU path: compute dispatches that ran workgroups and queue submissions (batches
+    /// of steps and readbacks) per step; the dispatches of a step between rebuilds of
+    /// the neighbour lists; and the rebuild stages' indirect dispatches that ran none
+    /// (encoded every step, empty between rebuilds: issue 14 item 2).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub dispatches_per_step: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub dispatches_between_rebuilds: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub empty_dispatches_per_step: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub submissions_per_step: Option<f64>,
     /// Neighbour-list rebuilds per 1000 steps (both paths), and on the CPU path the
@@ -123,7 +129,7 @@ fn engine(sim: Simulation, backend: BackendChoice) -> Result<Engine, String> {
     }
 }
 
-fn gpu_counters(e: &Engine) -> Option<(u64, u64)> {
+fn gpu_counters(e: &Engine) -> Option<crate::gpu::Counters> {
     match e {
         Engine::Gpu(g) => Some(g.counters()),
         Engine::Cpu(_) => None,
@@ -171,11 +177,17 @@ fn measure(
         }
     };
     let seconds = t.elapsed().as_secs_f64();
-    let per_step = |c: u64, c0: u64| (c - c0) as f64 / steps as f64;
-    let (dispatches, submissions) = match (counters0, gpu_counters(&e)) {
-        (Some((d0, s0)), Some((d, s))) => (Some(per_step(d, d0)), Some(per_step(s, s0))),
-        _ => (None, None),
-    };
+    let per_step = |c: u64| c as f64 / steps as f64;
+    let (mut dispatches, mut between, mut empty, mut submissions) = (None, None, None, None);
+    if let (Some(c0), Some(c)) = (counters0, gpu_counters(&e)) {
+        let stages = crate::gpu::REBUILD_STAGES.len() as u64;
+        let (direct, indirect) = (c.direct - c0.direct, c.indirect - c0.indirect);
+        let ran = (stages * (c.rebuilds - c0.rebuilds)).min(indirect);
+        dispatches = Some(per_step(direct + ran));
+        between = Some(per_step(direct));
+        empty = Some(per_step(indirect - ran));
+        submissions = Some(per_step(c.submissions - c0.submissions));
+    }
     let n = (n0 + e.active_count()) / 2;
     let (rebuilds, pairs, contacts) = match &e {
         Engine::Cpu(s) => {
@@ -207,6 +219,8 @@ fn measure(
         steps_per_second: steps as f64 / seconds.max(1e-12),
         microseconds_per_step: 1e6 * seconds / steps as f64,
         dispatches_per_step: dispatches,
+        dispatches_between_rebuilds: between,
+        empty_dispatches_per_step: empty,
         submissions_per_step: submissions,
         rebuilds_per_1000_steps: rebuilds,
         pairs_per_particle: pairs,
@@ -310,10 +324,16 @@ pub fn run(
                 (Some(r), None) => format!(", {r:.0} rebuilds per 1000 steps"),
                 _ => String::new(),
             };
-            let gpu = match (m.dispatches_per_step, m.submissions_per_step) {
-                (Some(d), Some(s)) => {
-                    format!(", {d:.1} dispatches and {s:.3} submissions per step")
-                }
+            let gpu = match (
+                m.dispatches_per_step,
+                m.dispatches_between_rebuilds,
+                m.empty_dispatches_per_step,
+                m.submissions_per_step,
+            ) {
+                (Some(d), Some(b), Some(e), Some(s)) => format!(
+                    ", {d:.1} dispatches ({b:.0} between rebuilds, {e:.1} empty) and \
+                     {s:.3} submissions per step"
+                ),
                 _ => String::new(),
             };
             log(format!(

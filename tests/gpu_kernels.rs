@@ -9,10 +9,10 @@ use std::collections::BTreeMap;
 use talus::cell_list::{CellList, Grid, prefix_sum};
 use talus::contacts::{Pair, find_contacts};
 use talus::forces::{contact_forces, reduce_forces};
-use talus::gpu::GpuSimulation;
 use talus::gpu::kernels::Kernel;
 use talus::gpu::layout::control::REBUILD;
 use talus::gpu::layout::{Entry, MAX_CONTACTS};
+use talus::gpu::{GpuSimulation, REBUILD_STAGES, workgroups};
 use talus::rng::Rng;
 use talus::shape::{RotatedCorners, rotate_corners};
 
@@ -1070,4 +1070,40 @@ fn clears_cover_everything_from_any_number_of_workgroups() {
     assert_eq!(keys(&g), entries.len(), "the springs are in");
     g.run_kernel_with_groups(Kernel::ClearTable, 1);
     assert_eq!(keys(&g), 0, "every slot of the table cleared");
+}
+
+#[test]
+fn rebuild_stages_run_workgroups_only_at_a_rebuild() {
+    // Issue 14 item 2: the rebuild stages are dispatched indirectly every step, with the
+    // workgroups `plan_rebuild` gives them: all of them at a rebuild, none between.
+    let Some(mut g) = setup(
+        "rebuild_stages_run_workgroups_only_at_a_rebuild",
+        &random_scene(300, spring_dashpot(), 9),
+    ) else {
+        return;
+    };
+    let stages = REBUILD_STAGES.len();
+    let this_step = |g: &GpuSimulation| -> Vec<u32> {
+        let words = g.read_u32("dispatch_args", 8 * stages);
+        (words[4 * stages..].chunks(4))
+            .map(|a| {
+                assert_eq!(a[1..3], [1, 1], "one-dimensional dispatches");
+                a[0]
+            })
+            .collect()
+    };
+    let full: Vec<u32> = (REBUILD_STAGES.iter())
+        .map(|&k| workgroups(&g.params, k) as u32)
+        .collect();
+    assert!(full.iter().all(|&x| x >= 1));
+    // The upload asks for a rebuild: the first step runs every stage.
+    g.advance(1).expect("runs");
+    assert_eq!((g.rebuilds(), this_step(&g)), (1, full.clone()));
+    // One step moves every disk by far less than skin/2: no rebuild, no workgroups.
+    g.advance(1).expect("runs");
+    assert_eq!((g.rebuilds(), this_step(&g)), (1, vec![0; stages]));
+    // A rebuild asked for (as an insertion or a removal asks) runs them again.
+    g.set_list_flags(REBUILD);
+    g.advance(1).expect("runs");
+    assert_eq!((g.rebuilds(), this_step(&g)), (2, full));
 }

@@ -16,8 +16,12 @@ pub enum BackendChoice {
     Gpu,
 }
 
-/// Storage buffers bound at once by the largest kernel (see `shaders/common.wgsl`).
-pub const STORAGE_BUFFERS_NEEDED: u32 = 27;
+/// Storage buffers bound at once by the largest pipeline layout: the spring table and
+/// `shaders/common.wgsl`'s bindings, and for `plan_rebuild` the indirect dispatch
+/// arguments (`kernels::GROUP2_STORAGE`).
+pub const STORAGE_BUFFERS_NEEDED: u32 = super::kernels::GROUP0_STORAGE
+    + super::kernels::GROUP1_STORAGE
+    + super::kernels::GROUP2_STORAGE;
 /// Every buffer bound at once by the largest kernel: the storage buffers and the uniform
 /// Params.
 pub const BUFFERS_NEEDED: u32 = STORAGE_BUFFERS_NEEDED + 1;
@@ -46,6 +50,12 @@ const BACKENDS: wgpu::Backends = wgpu::Backends::VULKAN
 fn instance() -> wgpu::Instance {
     let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
     desc.backends = BACKENDS;
+    // wgpu checks every indirect dispatch's arguments against the limits with a compute
+    // pass of its own, one more dispatch and barrier per indirect dispatch. talus's only
+    // indirect arguments are the rebuild stages' (shaders/plan.wgsl): the host's own
+    // workgroup counts, checked against the limits at the upload, or zero.
+    desc.flags
+        .remove(wgpu::InstanceFlags::VALIDATION_INDIRECT_CALL);
     wgpu::Instance::new(desc)
 }
 

@@ -45,6 +45,15 @@ pub const MODULES: &[ModuleSource] = &[
         ],
     },
     ModuleSource {
+        name: "plan",
+        parts: &[
+            COMMON,
+            POSITION,
+            ORIENTATION,
+            include_str!("../../shaders/plan.wgsl"),
+        ],
+    },
+    ModuleSource {
         name: "cell_index",
         parts: &[
             COMMON,
@@ -145,6 +154,7 @@ pub const MODULES: &[ModuleSource] = &[
             COMMON,
             POSITION,
             ORIENTATION,
+            include_str!("../../shaders/reduce_forces.wgsl"),
             include_str!("../../shaders/correct.wgsl"),
             include_str!("../../shaders/boundaries.wgsl"),
         ],
@@ -155,6 +165,7 @@ pub const MODULES: &[ModuleSource] = &[
             COMMON,
             POSITION,
             ORIENTATION,
+            include_str!("../../shaders/reduce_forces.wgsl"),
             include_str!("../../shaders/kick_drift.wgsl"),
             include_str!("../../shaders/boundaries.wgsl"),
         ],
@@ -183,6 +194,7 @@ pub enum Kernel {
     InsertPlace,
     Predict,
     Survey,
+    PlanRebuild,
     ClearCells,
     CellIndex,
     CellHistogram,
@@ -207,11 +219,12 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 25] = [
+    pub const ALL: [Kernel; 26] = [
         Kernel::InsertCheck,
         Kernel::InsertPlace,
         Kernel::Predict,
         Kernel::Survey,
+        Kernel::PlanRebuild,
         Kernel::ClearCells,
         Kernel::CellIndex,
         Kernel::CellHistogram,
@@ -242,6 +255,7 @@ impl Kernel {
             Kernel::InsertPlace => ("insert", "insert_place"),
             Kernel::Predict => ("predict", "predict"),
             Kernel::Survey => ("survey", "survey"),
+            Kernel::PlanRebuild => ("plan", "plan_rebuild"),
             Kernel::ClearCells => ("cell_index", "clear_cells"),
             Kernel::CellIndex => ("cell_index", "cell_index"),
             Kernel::CellHistogram => ("cell_histogram", "cell_histogram"),
@@ -267,9 +281,13 @@ impl Kernel {
     }
 }
 
-/// Storage bindings of group 0 (binding 0 is the uniform Params) and of group 1.
+/// Storage bindings of group 0 (binding 0 is the uniform Params), of group 1 (the spring
+/// table) and of group 2 (the indirect dispatch arguments, bound only to
+/// `plan_rebuild`: a buffer cannot be an indirect argument and writable storage in one
+/// dispatch).
 pub const GROUP0_STORAGE: u32 = 26;
 pub const GROUP1_STORAGE: u32 = 1;
+pub const GROUP2_STORAGE: u32 = 1;
 
 fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
@@ -287,6 +305,7 @@ fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 pub struct Pipelines {
     pub group0: wgpu::BindGroupLayout,
     pub group1: wgpu::BindGroupLayout,
+    pub group2: wgpu::BindGroupLayout,
     pub pipelines: std::collections::HashMap<Kernel, wgpu::ComputePipeline>,
 }
 
@@ -313,9 +332,18 @@ impl Pipelines {
             label: Some("talus springs"),
             entries: &(0..GROUP1_STORAGE).map(storage_entry).collect::<Vec<_>>(),
         });
+        let group2 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("talus dispatch arguments"),
+            entries: &(0..GROUP2_STORAGE).map(storage_entry).collect::<Vec<_>>(),
+        });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("talus"),
             bind_group_layouts: &[Some(&group0), Some(&group1)],
+            immediate_size: 0,
+        });
+        let plan_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("talus plan"),
+            bind_group_layouts: &[Some(&group0), Some(&group1), Some(&group2)],
             immediate_size: 0,
         });
         let modules: std::collections::HashMap<&str, wgpu::ShaderModule> = MODULES
@@ -339,7 +367,11 @@ impl Pipelines {
                 };
                 let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(entry),
-                    layout: Some(&layout),
+                    layout: Some(if k == Kernel::PlanRebuild {
+                        &plan_layout
+                    } else {
+                        &layout
+                    }),
                     module: &modules[module],
                     entry_point: Some(entry),
                     compilation_options: wgpu::PipelineCompilationOptions {
@@ -354,6 +386,7 @@ impl Pipelines {
         Self {
             group0,
             group1,
+            group2,
             pipelines,
         }
     }

@@ -120,6 +120,8 @@ struct Buffers {
     props_next: wgpu::Buffer,
     ids_next: wgpu::Buffer,
     table: wgpu::Buffer,
+    /// The rebuild stages' indirect dispatch arguments (shaders/plan.wgsl).
+    dispatch_args: wgpu::Buffer,
 }
 
 /// Per-slot values of the device put in id order (`ids`: each slot's id).
@@ -157,6 +159,60 @@ struct LayeredBase {
     index: usize,
 }
 
+/// The stages of a rebuild of the neighbour lists, in order: the old lists' springs into
+/// the table, the cell list, the new memory order, the new lists and their springs. A
+/// step dispatches them indirectly (`plan_rebuild`, shaders/plan.wgsl).
+pub const REBUILD_STAGES: [Kernel; 16] = {
+    let c = GpuSimulation::CELL_LIST;
+    [
+        Kernel::ClearTable,
+        Kernel::StoreHistory,
+        c[0],
+        c[1],
+        c[2],
+        c[3],
+        c[4],
+        c[5],
+        c[6],
+        c[7],
+        c[8],
+        c[9],
+        Kernel::PermuteGather,
+        Kernel::PermuteStore,
+        Kernel::FindContacts,
+        Kernel::GatherHistory,
+    ]
+};
+
+/// One indirect dispatch's arguments in `dispatch_args`: x, y, z and a word of padding.
+const DISPATCH_ARGS_BYTES: usize = 16;
+
+/// The workgroups of one dispatch of kernel k.
+pub fn workgroups(p: &Params, k: Kernel) -> u64 {
+    match k {
+        Kernel::InsertPlace | Kernel::ScanLevel2 | Kernel::AdvanceClock | Kernel::PlanRebuild => 1,
+        // Grid-stride loops: as many workgroups as one dispatch takes.
+        Kernel::ClearCells => ceil_div(p.cells.max(p.n_cap) as u64, WG as u64).min(MAX_WORKGROUPS),
+        Kernel::ClearCursor => ceil_div(p.cells as u64, WG as u64),
+        Kernel::ScanLevel0 | Kernel::ScanAdd0 => p.scan_blocks1 as u64,
+        Kernel::ScanLevel1 | Kernel::ScanAdd1 => p.scan_blocks2 as u64,
+        Kernel::ClearTable => ceil_div(p.table_mask as u64 + 1, WG as u64).min(MAX_WORKGROUPS),
+        _ => ceil_div(p.n_cap as u64, WG as u64),
+    }
+    .max(1)
+}
+
+/// The contents of `dispatch_args` at the upload: each rebuild stage's workgroups, then
+/// room for a step's arguments (shaders/plan.wgsl).
+fn dispatch_args(p: &Params) -> Vec<u32> {
+    let mut args: Vec<u32> = REBUILD_STAGES
+        .iter()
+        .flat_map(|&k| [workgroups(p, k) as u32, 1, 1, 0])
+        .collect();
+    args.resize(2 * args.len(), 0);
+    args
+}
+
 pub struct GpuSimulation {
     /// The host mirror; its state is current after [`GpuSimulation::download`].
     pub sim: Simulation,
@@ -166,6 +222,8 @@ pub struct GpuSimulation {
     group0: wgpu::BindGroup,
     /// The spring table's group.
     group1: wgpu::BindGroup,
+    /// The indirect dispatch arguments' group (`plan_rebuild` only).
+    group2: wgpu::BindGroup,
     pub params: Params,
     /// The device's grid: cells of at least the law's range plus the neighbour lists'
     /// skin (positions are anchored to its cells, see `position`).
@@ -185,10 +243,25 @@ pub struct GpuSimulation {
     step: u64,
     live: u32,
     synced: bool,
-    /// Dispatches encoded and submissions made (compute and readback) since the upload:
-    /// what `talus bench` reports per step.
+    /// Dispatches encoded (direct, and indirect: the rebuild stages) and submissions
+    /// made (compute and readback) since the upload: what `talus bench` reports per step.
     dispatches: std::cell::Cell<u64>,
+    indirect: std::cell::Cell<u64>,
     submissions: std::cell::Cell<u64>,
+}
+
+/// What the GPU path has encoded and submitted since the upload (`talus bench`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Counters {
+    /// Dispatches with a workgroup count fixed when encoded.
+    pub direct: u64,
+    /// Indirect dispatches: the rebuild stages, which run workgroups only at a rebuild.
+    pub indirect: u64,
+    /// Submissions: batches of steps and readbacks.
+    pub submissions: u64,
+    /// Rebuilds of the neighbour lists (each runs the `REBUILD_STAGES.len()` indirect
+    /// dispatches of its step).
+    pub rebuilds: u64,
 }
 
 /// What a GPU checkpoint adds to the f64 state: the exact device state, so that a GPU
@@ -578,6 +651,13 @@ impl GpuSimulation {
             props_next: zeroed("props_next", n * size_of::<Props>() as u64),
             ids_next: zeroed("ids_next", n * 4),
             table: init("springs", bytemuck::cast_slice(&table)),
+            dispatch_args: dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("dispatch_args"),
+                contents: bytemuck::cast_slice(&dispatch_args(&params)),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_SRC,
+            }),
         };
         let pipelines = Pipelines::new(dev, matches!(sim.law, ContactLaw::OverlapArea(_)));
         let b = &buffers;
@@ -631,6 +711,14 @@ impl GpuSimulation {
                 resource: b.table.as_entire_binding(),
             }],
         });
+        let group2 = dev.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("dispatch arguments"),
+            layout: &pipelines.group2,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: b.dispatch_args.as_entire_binding(),
+            }],
+        });
         let lost_base = sim.lost;
         let inactive_at_upload = (sim.particles.len() - sim.particles.active_count()) as u64;
         let step = sim.step;
@@ -641,6 +729,7 @@ impl GpuSimulation {
             buffers,
             group0,
             group1,
+            group2,
             params,
             grid,
             n_cap,
@@ -656,13 +745,19 @@ impl GpuSimulation {
             synced: true,
             dispatches: Default::default(),
             submissions: Default::default(),
+            indirect: Default::default(),
         })
     }
 
-    /// (dispatches, submissions) since the upload; a submission is a batch of steps or
-    /// a readback.
-    pub fn counters(&self) -> (u64, u64) {
-        (self.dispatches.get(), self.submissions.get())
+    /// What has been encoded and submitted since the upload (reads the rebuild count
+    /// back).
+    pub fn counters(&self) -> Counters {
+        Counters {
+            direct: self.dispatches.get(),
+            indirect: self.indirect.get(),
+            submissions: self.submissions.get(),
+            rebuilds: self.rebuilds(),
+        }
     }
 
     pub fn adapter_name(&self) -> &str {
@@ -695,26 +790,26 @@ impl GpuSimulation {
         pass.dispatch_workgroups(groups.max(1) as u32, 1, 1);
     }
 
-    fn per_particle(&self) -> u64 {
-        ceil_div(self.n_cap as u64, WG as u64)
+    /// Sets every bind group of the talus kernels on a pass.
+    fn bind_groups(&self, pass: &mut wgpu::ComputePass) {
+        pass.set_bind_group(0, &self.group0, &[]);
+        pass.set_bind_group(1, &self.group1, &[]);
+        pass.set_bind_group(2, &self.group2, &[]);
     }
 
     /// Records the dispatches of one kernel (for tests of single stages).
     pub fn encode_kernel(&self, pass: &mut wgpu::ComputePass, k: Kernel) {
-        let p = &self.params;
-        let groups = match k {
-            Kernel::InsertPlace | Kernel::ScanLevel2 | Kernel::AdvanceClock => 1,
-            // Grid-stride loops: as many workgroups as one dispatch takes.
-            Kernel::ClearCells => {
-                ceil_div(p.cells.max(p.n_cap) as u64, WG as u64).min(MAX_WORKGROUPS)
-            }
-            Kernel::ClearCursor => ceil_div(p.cells as u64, WG as u64),
-            Kernel::ScanLevel0 | Kernel::ScanAdd0 => p.scan_blocks1 as u64,
-            Kernel::ScanLevel1 | Kernel::ScanAdd1 => p.scan_blocks2 as u64,
-            Kernel::ClearTable => ceil_div(p.table_mask as u64 + 1, WG as u64).min(MAX_WORKGROUPS),
-            _ => self.per_particle(),
-        };
-        self.dispatch(pass, k, groups);
+        self.dispatch(pass, k, workgroups(&self.params, k));
+    }
+
+    /// Records a rebuild stage (the `REBUILD_STAGES[stage]`), dispatched with the
+    /// workgroups `plan_rebuild` wrote for this step: none between rebuilds.
+    fn dispatch_rebuild_stage(&self, pass: &mut wgpu::ComputePass, stage: usize) {
+        self.indirect.set(self.indirect.get() + 1);
+        let k = REBUILD_STAGES[stage];
+        pass.set_pipeline(&self.pipelines.pipelines[&k]);
+        let offset = (REBUILD_STAGES.len() + stage) * DISPATCH_ARGS_BYTES;
+        pass.dispatch_workgroups_indirect(&self.buffers.dispatch_args, offset as u64);
     }
 
     /// Runs one kernel with a given number of workgroups (tests of the grid-stride
@@ -723,8 +818,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_bind_group(0, &self.group0, &[]);
-            pass.set_bind_group(1, &self.group1, &[]);
+            self.bind_groups(&mut pass);
             self.dispatch(&mut pass, k, groups);
         }
         self.gpu.queue.submit([enc.finish()]);
@@ -736,8 +830,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_bind_group(0, &self.group0, &[]);
-            pass.set_bind_group(1, &self.group1, &[]);
+            self.bind_groups(&mut pass);
             for &k in ks {
                 self.encode_kernel(&mut pass, k);
             }
@@ -779,22 +872,13 @@ impl GpuSimulation {
                 Kernel::Survey
             },
         );
-        for k in [Kernel::ClearTable, Kernel::StoreHistory] {
-            self.encode_kernel(pass, k);
+        // Between rebuilds the rebuild stages are dispatched with no workgroups (issue 14
+        // item 2): `plan_rebuild` writes their arguments once the survey has decided.
+        self.encode_kernel(pass, Kernel::PlanRebuild);
+        for stage in 0..REBUILD_STAGES.len() {
+            self.dispatch_rebuild_stage(pass, stage);
         }
-        for k in Self::CELL_LIST {
-            self.encode_kernel(pass, k);
-        }
-        for k in [
-            Kernel::PermuteGather,
-            Kernel::PermuteStore,
-            Kernel::FindContacts,
-            Kernel::GatherHistory,
-            Kernel::ContactForces,
-            Kernel::ReduceForces,
-        ] {
-            self.encode_kernel(pass, k);
-        }
+        self.encode_kernel(pass, Kernel::ContactForces);
         self.encode_kernel(
             pass,
             if gear {
@@ -803,7 +887,8 @@ impl GpuSimulation {
                 Kernel::KickDrift
             },
         );
-        // (The integrators' kernels end with the boundaries.)
+        // (The integrators' kernels sum each particle's forces first and end with the
+        // boundaries.)
         self.encode_kernel(pass, Kernel::AdvanceClock);
     }
 
@@ -877,8 +962,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_bind_group(0, &self.group0, &[]);
-            pass.set_bind_group(1, &self.group1, &[]);
+            self.bind_groups(&mut pass);
             for _ in 0..k {
                 self.encode_step(&mut pass, sources_left);
             }
@@ -1235,8 +1319,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            pass.set_bind_group(0, &self.group0, &[]);
-            pass.set_bind_group(1, &self.group1, &[]);
+            self.bind_groups(&mut pass);
             self.encode_kernel(&mut pass, Kernel::ClearTable);
             self.encode_kernel(&mut pass, Kernel::StoreHistory);
         }
@@ -1299,6 +1382,7 @@ impl GpuSimulation {
             "touching" => &b.touching,
             "table" => &b.table,
             "control" => &b.control,
+            "dispatch_args" => &b.dispatch_args,
             _ => panic!("unknown buffer {name}"),
         };
         self.read_buffer(buf, 0, count)
