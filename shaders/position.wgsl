@@ -116,23 +116,36 @@ fn distance_units(d: vec2<i32>, e: vec2<f32>) -> Distance {
 // (exact: rem - round(rem) is representable), so that |rem| <= 0.5 and
 // 0 <= frac < 2^30.
 fn renormalize(s: ptr<function, State>) {
-    for (var k = 0u; k < 2u; k++) {
-        var rem = (*s).q[0][k];
-        var a = (*s).anchor[k];
-        // A move of a cell or more in one step (only while diverging): whole cells first.
-        if (abs(rem) >= 5.0e8) {
-            let c = trunc(rem / f32(FRAC_ONE));
-            rem -= c * f32(FRAC_ONE);
-            a += i32(c);
-        }
-        let whole = round(rem);
-        rem -= whole;
-        let f = i32((*s).frac[k]) + i32(whole);
-        a += f >> 30u;
-        (*s).frac[k] = u32(f & FRAC_MASK);
-        (*s).anchor[k] = a;
-        (*s).q[0][k] = rem;
+    // Per axis, without a loop: an index into a vector that is not a constant puts the
+    // whole state in memory on most compilers.
+    let x = renormalize_axis((*s).q[0].x, (*s).anchor.x, (*s).frac.x);
+    let z = renormalize_axis((*s).q[0].y, (*s).anchor.y, (*s).frac.y);
+    (*s).q[0] = vec4<f32>(x.rem, z.rem, (*s).q[0].zw);
+    (*s).anchor = vec2<i32>(x.anchor, z.anchor);
+    (*s).frac = vec2<u32>(x.frac, z.frac);
+}
+
+// One coordinate of a fixed-point position (anchor, frac, remainder).
+struct Axis {
+    anchor: i32,
+    frac: u32,
+    rem: f32,
+};
+
+fn renormalize_axis(rem_in: f32, anchor: i32, frac: u32) -> Axis {
+    var rem = rem_in;
+    var a = anchor;
+    // A move of a cell or more in one step (only while diverging): whole cells first.
+    if (abs(rem) >= 5.0e8) {
+        let c = trunc(rem / f32(FRAC_ONE));
+        rem -= c * f32(FRAC_ONE);
+        a += i32(c);
     }
+    let whole = round(rem);
+    rem -= whole;
+    let f = i32(frac) + i32(whole);
+    a += f >> 30u;
+    return Axis(a, u32(f & FRAC_MASK), rem);
 }
 
 // Adds a displacement (length units) to the position.
