@@ -5,11 +5,15 @@
 // history in the candidate's slot; a candidate that does not touch gets zero force and
 // history. Flags a diverging contact.
 
-// Whether disks i and j interact (r < range_factor * sigma). The f32 distance is right
-// to ~1e-7 relative, so only pairs within 1e-5 of the boundary need the exact geometry
-// `g` (disk_disk(i, j), computed by the caller anyway).
-fn disks_touch(i: u32, j: u32, g: Geometry) -> bool {
-    let o = offset_ij(i, j);
+// Whether to store what only outputs read (`contact_info`, `contact_geo`): the host
+// builds the step that ends an `advance` with it, the others without (32 bytes per
+// candidate and step less; `Kernel::ContactForcesOnly`).
+override RECORD: bool = true;
+
+// Whether disks i and j at offset o interact (r < range_factor * sigma). The f32
+// distance is right to ~1e-7 relative, so only pairs within 1e-5 of the boundary need
+// the exact geometry `g` (disk_disk(i, j), computed by the caller anyway).
+fn disks_touch(o: Offset, i: u32, j: u32, g: Geometry) -> bool {
     if (!o.near) { return false; }
     let v = offset_vector(o);
     let reach = params.range_factor * (props[i].radius + props[j].radius);
@@ -55,8 +59,10 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         var rmin = ri;
         var m12 = m1;
         var mass = m1;
+        var o: Offset;
         if (!wall) {
-            d_ij = offset_vector(offset_ij(i, j));
+            o = offset_ij(i, j);
+            d_ij = offset_vector(o);
             v2 = velocity(j);
             rmin = min(ri, props[j].radius);
             let m2 = props[j].mass;
@@ -90,8 +96,8 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
             g = disk_wall(i, j - WALL_BASE);
             touches = g.r < params.range_factor * g.sigma;
         } else {
-            g = disk_disk(i, j);
-            touches = disks_touch(i, j, g);
+            g = disk_disk_at(o, i, j);
+            touches = disks_touch(o, i, j, g);
         }
         if (!touches) {
             contact_ft[slot] = vec4<f32>(0.0);
@@ -113,12 +119,18 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
         let res = evaluate(input);
         let f = res.f_n * g.n + res.f_t * t;
         contact_ft[slot] = vec4<f32>(f, cross2(l1, f), -cross2(l2, f));
-        contact_info[slot] = vec4<f32>(res.f_n, res.f_t, g.delta, res.energy);
-        contact_geo[slot] = vec4<f32>(g.n, l1);
         // In place: the slot's spring is the list's history from step to step.
         hist_in[slot] = res.history;
         let finite = abs(f.x) <= 3.0e38 && abs(f.y) <= 3.0e38;
+        let too_deep = g.delta / rmin > params.max_overlap;
         if (!finite) { halt(HALT_NOT_FINITE, i); }
-        if (g.delta / rmin > params.max_overlap) { halt(HALT_OVERLAP, i); }
+        if (too_deep) { halt(HALT_OVERLAP, i); }
+        // A diverging contact is recorded whatever the step: the halt report names the
+        // deepest overlap of the particle (`GpuSimulation::halt_cause`), and older
+        // records of its slots are all within the limit, or their step would have halted.
+        if (RECORD || !finite || too_deep) {
+            contact_info[slot] = vec4<f32>(res.f_n, res.f_t, g.delta, res.energy);
+            contact_geo[slot] = vec4<f32>(g.n, l1);
+        }
     }
 }

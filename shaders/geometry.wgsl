@@ -34,10 +34,13 @@ fn point_pair(o: Offset, sig_whole: i32, sig_rem: f32, r1: f32) -> Geometry {
 }
 
 fn disk_disk(i: u32, j: u32) -> Geometry {
-    let pi = props[i];
-    let pj = props[j];
-    return point_pair(offset_ij(i, j), i32(pi.radius_units + pj.radius_units),
-                      pi.radius_rem + pj.radius_rem, pi.radius);
+    return disk_disk_at(offset_ij(i, j), i, j);
+}
+
+// `disk_disk` from the pair's offset o = centre i - centre j.
+fn disk_disk_at(o: Offset, i: u32, j: u32) -> Geometry {
+    return point_pair(o, i32(props[i].radius_units + props[j].radius_units),
+                      props[i].radius_rem + props[j].radius_rem, props[i].radius);
 }
 
 // --- the line of a wall, exactly (issue 18) ---

@@ -37,9 +37,9 @@ fn offset(ai: vec2<i32>, fi: vec2<u32>, ri: vec2<f32>,
 }
 
 fn offset_ij(i: u32, j: u32) -> Offset {
-    let si = state[i];
-    let sj = state[j];
-    return offset(si.anchor, si.frac, si.q[0].xy, sj.anchor, sj.frac, sj.q[0].xy);
+    // Only the position's fields (a copy of the whole State would load 128 bytes each).
+    return offset(state[i].anchor, state[i].frac, state[i].q[0].xy,
+                  state[j].anchor, state[j].frac, state[j].q[0].xy);
 }
 
 // The offset as an f32 vector in length units, to f32's relative precision of its

@@ -210,6 +210,9 @@ pub enum Kernel {
     FindContacts,
     GatherHistory,
     ContactForces,
+    /// `contact_forces` without what only outputs read (`RECORD` off): every step but
+    /// the last of an `advance`.
+    ContactForcesOnly,
     ClearTable,
     StoreHistory,
     ReduceForces,
@@ -219,7 +222,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 26] = [
+    pub const ALL: [Kernel; 27] = [
         Kernel::InsertCheck,
         Kernel::InsertPlace,
         Kernel::Predict,
@@ -240,6 +243,7 @@ impl Kernel {
         Kernel::FindContacts,
         Kernel::GatherHistory,
         Kernel::ContactForces,
+        Kernel::ContactForcesOnly,
         Kernel::ClearTable,
         Kernel::StoreHistory,
         Kernel::ReduceForces,
@@ -270,7 +274,9 @@ impl Kernel {
             Kernel::PermuteStore => ("permute", "permute_store"),
             Kernel::FindContacts => ("find_contacts", "find_contacts"),
             Kernel::GatherHistory => ("gather_history", "gather_history"),
-            Kernel::ContactForces => ("contact_forces", "contact_forces"),
+            Kernel::ContactForces | Kernel::ContactForcesOnly => {
+                ("contact_forces", "contact_forces")
+            }
             Kernel::ClearTable => ("store_history", "clear_table"),
             Kernel::StoreHistory => ("store_history", "store_history"),
             Kernel::ReduceForces => ("reduce_forces", "reduce_forces"),
@@ -360,9 +366,18 @@ impl Pipelines {
             .iter()
             .map(|&k| {
                 let (module, entry) = k.entry();
-                let flag = [("POLYGONS", if polygons { 1.0 } else { 0.0 })];
+                let polygons = ("POLYGONS", if polygons { 1.0 } else { 0.0 });
+                let record = (
+                    "RECORD",
+                    if k == Kernel::ContactForcesOnly {
+                        0.0
+                    } else {
+                        1.0
+                    },
+                );
                 let constants: &[(&str, f64)] = match module {
-                    "find_contacts" | "contact_forces" => &flag,
+                    "find_contacts" => &[polygons],
+                    "contact_forces" => &[polygons, record],
                     _ => &[],
                 };
                 let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

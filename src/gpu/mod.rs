@@ -853,17 +853,18 @@ impl GpuSimulation {
         Kernel::Scatter,
     ];
 
-    /// One time step, stage by stage as in `Simulation::step`.
-    fn encode_step(&self, pass: &mut wgpu::ComputePass, sources_left: bool) {
+    /// One time step, stage by stage as in `Simulation::step`. `record`: store each
+    /// contact's outputs too (the last step of an `advance`, which `download` reads).
+    fn encode_step(&self, pass: &mut wgpu::ComputePass, sources_left: bool, record: bool) {
         if sources_left {
             self.encode_kernel(pass, Kernel::InsertCheck);
             self.encode_kernel(pass, Kernel::InsertPlace);
         }
         let gear = self.params.integrator == 0;
         // The neighbour lists (issue 13): the survey decides whether this step rebuilds
-        // them; the stages of a rebuild (the old lists' springs into the table, the cell
-        // list, the new lists, their springs from the table) return at once otherwise.
-        // Gear's prediction surveys each particle it predicts.
+        // them (the stages of a rebuild: the old lists' springs into the table, the cell
+        // list, the memory order, the new lists, their springs from the table). Gear's
+        // prediction surveys each particle it predicts.
         self.encode_kernel(
             pass,
             if gear {
@@ -878,7 +879,14 @@ impl GpuSimulation {
         for stage in 0..REBUILD_STAGES.len() {
             self.dispatch_rebuild_stage(pass, stage);
         }
-        self.encode_kernel(pass, Kernel::ContactForces);
+        self.encode_kernel(
+            pass,
+            if record {
+                Kernel::ContactForces
+            } else {
+                Kernel::ContactForcesOnly
+            },
+        );
         self.encode_kernel(
             pass,
             if gear {
@@ -927,7 +935,8 @@ impl GpuSimulation {
                     None => {}
                 }
                 if k > 0 {
-                    in_flight.push_back(self.submit_batch(k, sources_left));
+                    let last = k == left;
+                    in_flight.push_back(self.submit_batch(k, sources_left, last));
                     planned += k;
                     left -= k;
                     continue;
@@ -951,7 +960,8 @@ impl GpuSimulation {
     }
 
     /// Encodes and submits `k` steps, with a copy of the control words at their end.
-    fn submit_batch(&mut self, k: u64, sources_left: bool) -> Batch {
+    /// `last`: the batch ends the `advance`; its last step records the contacts.
+    fn submit_batch(&mut self, k: u64, sources_left: bool, last: bool) -> Batch {
         let words = control::BLOCKED;
         let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("control readback"),
@@ -963,8 +973,8 @@ impl GpuSimulation {
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
             self.bind_groups(&mut pass);
-            for _ in 0..k {
-                self.encode_step(&mut pass, sources_left);
+            for step in 1..=k {
+                self.encode_step(&mut pass, sources_left, last && step == k);
             }
         }
         enc.copy_buffer_to_buffer(&self.buffers.control, 0, &staging, 0, (words * 4) as u64);
@@ -1095,6 +1105,8 @@ impl GpuSimulation {
         self.sim.step = halt_step;
         if flags & control::HALT_OVERLAP != 0 {
             let limit = self.sim.scene.limits.max_overlap;
+            // The halting step recorded the diverging contacts (contact_forces.wgsl); the
+            // others' records are older and within the limit.
             let mut worst: Option<(u32, f64)> = None;
             for (p, cf) in self.sim.pairs.iter().zip(&self.sim.contacts) {
                 if p.i != id {
