@@ -19,6 +19,25 @@ fn lookup(i: u32, j: u32) -> f32 {
     return 0.0;
 }
 
+// Particle p's down list (its candidates as the higher id) sorted by the id of the lower
+// particle: the order in which `kick_sum` adds them at every step until the next rebuild
+// (src/neighbours.rs `down_lists` builds them in that order; find_contacts appends them
+// in whatever order its threads arrive). Sorted in place, once per rebuild.
+fn sort_down_list(p: u32) {
+    let nd = min(atomicLoad(&down_count[p]), MAX_CONTACTS);
+    let base = p * MAX_CONTACTS;
+    for (var a = 1u; a < nd; a++) {
+        let s = down[base + a];
+        let key = ids[s / MAX_CONTACTS];
+        var k = a;
+        while (k > 0u && ids[down[base + k - 1u] / MAX_CONTACTS] > key) {
+            down[base + k] = down[base + k - 1u];
+            k--;
+        }
+        down[base + k] = s;
+    }
+}
+
 @compute @workgroup_size(WG)
 fn gather_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
@@ -27,4 +46,5 @@ fn gather_history(@builtin(global_invocation_id) gid: vec3<u32>) {
         let slot = i * MAX_CONTACTS + k;
         hist_in[slot] = lookup(ids[i], partner_key(contact_j[slot]));
     }
+    sort_down_list(i);
 }

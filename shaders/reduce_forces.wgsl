@@ -9,24 +9,10 @@
 // The total contact force and torque (fx, fz, τ) on particle p.
 fn kick_sum(p: u32) -> vec3<f32> {
     var acc = vec3<f32>(0.0);
+    // The down list is in id order since the rebuild (gather_history.wgsl).
     let nd = min(atomicLoad(&down_count[p]), MAX_CONTACTS);
-    var slots: array<u32, MAX_CONTACTS>;
-    var keys: array<u32, MAX_CONTACTS>;
     for (var a = 0u; a < nd; a++) {
-        let s = down[p * MAX_CONTACTS + a];
-        // Each lower particle lists p once: its id orders the sum.
-        let key = ids[s / MAX_CONTACTS];
-        var k = a;
-        while (k > 0u && keys[k - 1u] > key) {
-            slots[k] = slots[k - 1u];
-            keys[k] = keys[k - 1u];
-            k--;
-        }
-        slots[k] = s;
-        keys[k] = key;
-    }
-    for (var a = 0u; a < nd; a++) {
-        let ft = contact_ft[slots[a]];
+        let ft = contact_ft[down[p * MAX_CONTACTS + a]];
         acc -= vec3<f32>(ft.xy, 0.0);
         acc.z += ft.w;
     }
