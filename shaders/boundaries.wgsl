@@ -23,9 +23,10 @@ fn advance_clock() {
     if (!halted()) {
         atomicAdd(&control[C_STEP], 1u);
         // The lists are current; what the next step needs is asked for again, but a
-        // removal at the end of this one already asks for a rebuild.
+        // removal at the end of this one, or the survey of its prediction run ahead,
+        // already asks for a rebuild.
         if (rebuilding()) { atomicAdd(&control[C_REBUILDS], 1u); }
-        let removed = (lists_word() & REMOVED) != 0u;
-        atomicStore(&control[C_LISTS], select(0u, REBUILD, removed));
+        let next = (lists_word() & (REMOVED | AHEAD_REBUILD)) != 0u;
+        atomicStore(&control[C_LISTS], select(0u, REBUILD, next));
     }
 }

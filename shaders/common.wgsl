@@ -42,6 +42,9 @@ const TABLE_CURRENT: u32 = 2u;
 const FLUSH: u32 = 4u;
 // A particle was removed at the end of this step: the next step rebuilds the lists.
 const REMOVED: u32 = 8u;
+// The survey of the next step's prediction, run ahead at the end of this one (`correct`
+// with AHEAD), asks for a rebuild: the next step rebuilds the lists.
+const AHEAD_REBUILD: u32 = 16u;
 // Halt reasons (bits of control[C_HALT]).
 const HALT_OVERLAP: u32 = 1u;
 const HALT_NOT_FINITE: u32 = 2u;

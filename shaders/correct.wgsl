@@ -2,6 +2,11 @@
 // velocity-dependent forces (Allen & Tildesley). Each particle's contact forces are summed
 // here as it is corrected (`acceleration`, reduce_forces.wgsl).
 
+// Whether to predict the particle for the next step once corrected (src/sim.rs
+// `correct_ahead`; `Kernel::CorrectAhead`): the host asks for it when another step
+// follows on the device at once, with no insertion before its prediction.
+override AHEAD: bool = false;
+
 fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
     let half_dt2 = 0.5 * params.dt * params.dt;
     let delta = half_dt2 * accel - (*s).q[2];
@@ -29,4 +34,7 @@ fn correct(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     // The boundaries (boundaries.wgsl; src/sim.rs `remove_escaped`).
     leave_domain(i);
+    // The next step's prediction and survey (predict.wgsl): one dispatch and one pass
+    // over the state less per step.
+    if (AHEAD) { predict_particle(i, AHEAD_REBUILD); }
 }

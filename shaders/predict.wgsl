@@ -16,10 +16,9 @@ fn predict_one(s: ptr<function, State>) {
     (*s).q[4] += 5.0 * q5;
 }
 
-@compute @workgroup_size(WG)
-fn predict(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let i = gid.x;
-    if (i >= live() || halted()) { return; }
+// Particle i predicted, then surveyed (`bit`: see `survey_one`). `correct` with AHEAD
+// runs it for the next step (src/sim.rs `correct_ahead`).
+fn predict_particle(i: u32, bit: u32) {
     if (is_integrated(i)) {
         var s = state[i];
         predict_one(&s);
@@ -30,5 +29,12 @@ fn predict(@builtin(global_invocation_id) gid: vec3<u32>) {
         rotate_corners(i, s);
     }
     // The survey of the predicted particle (survey.wgsl; src/sim.rs `survey_with`).
-    survey_one(i);
+    survey_one(i, bit);
+}
+
+@compute @workgroup_size(WG)
+fn predict(@builtin(global_invocation_id) gid: vec3<u32>) {
+    let i = gid.x;
+    if (i >= live() || halted()) { return; }
+    predict_particle(i, REBUILD);
 }

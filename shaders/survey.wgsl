@@ -17,18 +17,20 @@ fn moved(s: State) -> bool {
 }
 
 // Particle i's part of the survey; Gear's `predict` runs it for each particle once
-// predicted (one dispatch fewer per step), leapfrog's step the kernel below.
-fn survey_one(i: u32) {
+// predicted (one dispatch fewer per step), leapfrog's step the kernel below. `bit`: the
+// lists' bit it sets, REBUILD for this step, AHEAD_REBUILD for the next (a prediction
+// run ahead in `correct`).
+fn survey_one(i: u32, bit: u32) {
     if (params.skin <= 0.0) {
-        if (i == 0u) { request_rebuild(); }
+        if (i == 0u) { atomicOr(&control[C_LISTS], bit); }
         return;
     }
-    if (is_active(i) && moved(state[i])) { request_rebuild(); }
+    if (is_active(i) && moved(state[i])) { atomicOr(&control[C_LISTS], bit); }
 }
 
 @compute @workgroup_size(WG)
 fn survey(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= live() || halted()) { return; }
-    survey_one(i);
+    survey_one(i, REBUILD);
 }

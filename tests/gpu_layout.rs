@@ -128,6 +128,7 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("TABLE_CURRENT", c::TABLE_CURRENT as f64),
         ("FLUSH", c::FLUSH as f64),
         ("REMOVED", c::REMOVED as f64),
+        ("AHEAD_REBUILD", c::AHEAD_REBUILD as f64),
         ("HALT_OVERLAP", c::HALT_OVERLAP as f64),
         ("HALT_NOT_FINITE", c::HALT_NOT_FINITE as f64),
         ("HALT_CONTACTS_FULL", c::HALT_CONTACTS_FULL as f64),

@@ -883,3 +883,56 @@ fn a_particle_leaving_the_domain_leaves_the_gpu_lists() {
     assert_eq!(g.download().particles.active_count(), 1, "the disk left");
     assert_eq!(g.rebuilds(), 2, "rebuilt once after the removal");
 }
+
+#[test]
+fn gear_predicting_ahead_changes_no_bit() {
+    // Issue 14 item 4: inside one `advance`, Gear's prediction of the next step runs at
+    // the end of the step before (`Kernel::CorrectAhead`, the CPU path's
+    // `correct_ahead`), except before a stop (a layered row, the end). A layered pile of
+    // disks and one of heptagons (whose corners the prediction turns), with a small skin
+    // so that the survey run ahead decides many rebuilds: advanced in one call and one
+    // step at a time (never ahead), bitwise the same, with the same rebuilds.
+    for polygons in [false, true] {
+        let name = format!("gear_predicting_ahead (polygons: {polygons})");
+        let scene = || {
+            let mut s = layered_pile(polygons);
+            s.skin = Some(0.05);
+            s
+        };
+        let Some(mut ahead) = gpu_sim(&name, scene()) else {
+            return;
+        };
+        let mut stepwise = gpu_sim(&name, scene()).unwrap();
+        let steps = 1600;
+        ahead.advance(steps).unwrap();
+        for _ in 0..steps {
+            stepwise.advance(1).unwrap();
+        }
+        let (a, b) = (ahead.counters(), stepwise.counters());
+        eprintln!("{name}: {a:?} against {b:?}");
+        assert!(
+            a.rebuilds > 10,
+            "{name}: the lists were rebuilt ({})",
+            a.rebuilds
+        );
+        assert_eq!(a.rebuilds, b.rebuilds, "{name}: the same rebuilds");
+        assert!(
+            a.direct + steps / 2 < b.direct,
+            "{name}: the prediction ran ahead ({} against {} dispatches)",
+            a.direct,
+            b.direct
+        );
+        let (sa, sb) = (ahead.device_state(), stepwise.device_state());
+        assert!(
+            sa.states.len() > 25,
+            "{name}: rows were laid ({})",
+            sa.states.len()
+        );
+        assert!(sa == sb, "{name}: the runs differ");
+        assert_eq!(
+            ahead.download().contacts,
+            stepwise.download().contacts,
+            "{name}: the same contacts"
+        );
+    }
+}

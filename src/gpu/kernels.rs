@@ -155,6 +155,8 @@ pub const MODULES: &[ModuleSource] = &[
             POSITION,
             ORIENTATION,
             include_str!("../../shaders/reduce_forces.wgsl"),
+            include_str!("../../shaders/survey.wgsl"),
+            include_str!("../../shaders/predict.wgsl"),
             include_str!("../../shaders/correct.wgsl"),
             include_str!("../../shaders/boundaries.wgsl"),
         ],
@@ -217,12 +219,14 @@ pub enum Kernel {
     StoreHistory,
     ReduceForces,
     Correct,
+    /// `correct` followed by the next step's prediction and survey (`AHEAD` on).
+    CorrectAhead,
     KickDrift,
     AdvanceClock,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 27] = [
+    pub const ALL: [Kernel; 28] = [
         Kernel::InsertCheck,
         Kernel::InsertPlace,
         Kernel::Predict,
@@ -248,6 +252,7 @@ impl Kernel {
         Kernel::StoreHistory,
         Kernel::ReduceForces,
         Kernel::Correct,
+        Kernel::CorrectAhead,
         Kernel::KickDrift,
         Kernel::AdvanceClock,
     ];
@@ -280,7 +285,7 @@ impl Kernel {
             Kernel::ClearTable => ("store_history", "clear_table"),
             Kernel::StoreHistory => ("store_history", "store_history"),
             Kernel::ReduceForces => ("reduce_forces", "reduce_forces"),
-            Kernel::Correct => ("correct", "correct"),
+            Kernel::Correct | Kernel::CorrectAhead => ("correct", "correct"),
             Kernel::KickDrift => ("kick_drift", "kick_drift"),
             Kernel::AdvanceClock => ("boundaries", "advance_clock"),
         }
@@ -375,9 +380,11 @@ impl Pipelines {
                         1.0
                     },
                 );
+                let ahead = ("AHEAD", if k == Kernel::CorrectAhead { 1.0 } else { 0.0 });
                 let constants: &[(&str, f64)] = match module {
                     "find_contacts" => &[polygons],
                     "contact_forces" => &[polygons, record],
+                    "correct" => &[ahead],
                     _ => &[],
                 };
                 let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {

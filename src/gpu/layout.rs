@@ -36,6 +36,9 @@ pub mod control {
     pub const TABLE_CURRENT: u32 = 2;
     pub const FLUSH: u32 = 4;
     pub const REMOVED: u32 = 8;
+    /// The next step rebuilds: asked for by the survey of Gear's prediction run ahead in
+    /// `correct` (`Kernel::CorrectAhead`).
+    pub const AHEAD_REBUILD: u32 = 16;
     /// How many times the device built the lists (`C_REBUILDS`).
     pub const REBUILDS: usize = 7;
     /// Inactive particles counted at a rebuild (`C_INACTIVE`).

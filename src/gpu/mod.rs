@@ -184,6 +184,20 @@ pub const REBUILD_STAGES: [Kernel; 16] = {
     ]
 };
 
+/// What a step encodes besides its fixed stages.
+#[derive(Clone, Copy, Debug)]
+struct StepKind {
+    /// Sources still have candidates: the insertion kernels run first.
+    sources_left: bool,
+    /// Store the contacts' outputs (the last step of an `advance`, which `download`
+    /// reads).
+    record: bool,
+    /// Gear: the step before predicted this one already (`Kernel::CorrectAhead`).
+    predicted: bool,
+    /// Gear: predict the next step at the end of this one.
+    ahead: bool,
+}
+
 /// One indirect dispatch's arguments in `dispatch_args`: x, y, z and a word of padding.
 const DISPATCH_ARGS_BYTES: usize = 16;
 
@@ -853,10 +867,9 @@ impl GpuSimulation {
         Kernel::Scatter,
     ];
 
-    /// One time step, stage by stage as in `Simulation::step`. `record`: store each
-    /// contact's outputs too (the last step of an `advance`, which `download` reads).
-    fn encode_step(&self, pass: &mut wgpu::ComputePass, sources_left: bool, record: bool) {
-        if sources_left {
+    /// One time step, stage by stage as in `Simulation::step`.
+    fn encode_step(&self, pass: &mut wgpu::ComputePass, how: StepKind) {
+        if how.sources_left {
             self.encode_kernel(pass, Kernel::InsertCheck);
             self.encode_kernel(pass, Kernel::InsertPlace);
         }
@@ -864,15 +877,13 @@ impl GpuSimulation {
         // The neighbour lists (issue 13): the survey decides whether this step rebuilds
         // them (the stages of a rebuild: the old lists' springs into the table, the cell
         // list, the memory order, the new lists, their springs from the table). Gear's
-        // prediction surveys each particle it predicts.
-        self.encode_kernel(
-            pass,
-            if gear {
-                Kernel::Predict
-            } else {
-                Kernel::Survey
-            },
-        );
+        // prediction surveys each particle it predicts; the step before may have run it
+        // ahead.
+        if !gear {
+            self.encode_kernel(pass, Kernel::Survey);
+        } else if !how.predicted {
+            self.encode_kernel(pass, Kernel::Predict);
+        }
         // Between rebuilds the rebuild stages are dispatched with no workgroups (issue 14
         // item 2): `plan_rebuild` writes their arguments once the survey has decided.
         self.encode_kernel(pass, Kernel::PlanRebuild);
@@ -881,7 +892,7 @@ impl GpuSimulation {
         }
         self.encode_kernel(
             pass,
-            if record {
+            if how.record {
                 Kernel::ContactForces
             } else {
                 Kernel::ContactForcesOnly
@@ -889,10 +900,10 @@ impl GpuSimulation {
         );
         self.encode_kernel(
             pass,
-            if gear {
-                Kernel::Correct
-            } else {
-                Kernel::KickDrift
+            match (gear, how.ahead) {
+                (true, false) => Kernel::Correct,
+                (true, true) => Kernel::CorrectAhead,
+                (false, _) => Kernel::KickDrift,
             },
         );
         // (The integrators' kernels sum each particle's forces first and end with the
@@ -915,6 +926,12 @@ impl GpuSimulation {
     /// names its step.
     pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
         let sources_left = self.sources_left();
+        // Gear's prediction runs ahead at the end of the step before (`CorrectAhead`, as
+        // the CPU path's `correct_ahead`) when the device goes on at once: not across an
+        // insertion (new particles are predicted in their step), nor into a stop (the end
+        // of the advance, a layered row: the host reads a corrected state).
+        let can_run_ahead = self.params.integrator == 0 && !sources_left;
+        let mut predicted = false;
         let mut left = steps;
         let mut in_flight: std::collections::VecDeque<Batch> = Default::default();
         // The step the device reaches once the batches in flight are done.
@@ -936,7 +953,15 @@ impl GpuSimulation {
                 }
                 if k > 0 {
                     let last = k == left;
-                    in_flight.push_back(self.submit_batch(k, sources_left, last));
+                    let stops = last || self.next_layered_step(planned + k) == Some(planned + k);
+                    let how = StepKind {
+                        sources_left,
+                        record: false,
+                        predicted,
+                        ahead: can_run_ahead,
+                    };
+                    in_flight.push_back(self.submit_batch(k, how, last, stops));
+                    predicted = can_run_ahead && !stops;
                     planned += k;
                     left -= k;
                     continue;
@@ -960,8 +985,10 @@ impl GpuSimulation {
     }
 
     /// Encodes and submits `k` steps, with a copy of the control words at their end.
-    /// `last`: the batch ends the `advance`; its last step records the contacts.
-    fn submit_batch(&mut self, k: u64, sources_left: bool, last: bool) -> Batch {
+    /// `how`: its first step (and whether steps may predict ahead); `last`: the batch
+    /// ends the `advance`, its last step records the contacts; `stops`: the device stops
+    /// after it (the end, a layered row), its last step does not predict ahead.
+    fn submit_batch(&mut self, k: u64, first: StepKind, last: bool, stops: bool) -> Batch {
         let words = control::BLOCKED;
         let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("control readback"),
@@ -973,8 +1000,14 @@ impl GpuSimulation {
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
             self.bind_groups(&mut pass);
+            let mut how = first;
             for step in 1..=k {
-                self.encode_step(&mut pass, sources_left, last && step == k);
+                let end = step == k;
+                let ahead = first.ahead && !(end && stops);
+                how.record = last && end;
+                how.ahead = ahead;
+                self.encode_step(&mut pass, how);
+                how.predicted = ahead;
             }
         }
         enc.copy_buffer_to_buffer(&self.buffers.control, 0, &staging, 0, (words * 4) as u64);
