@@ -1,0 +1,435 @@
+//! Steps on the device: the kernels of a step (`encode_step`), the rebuild stages
+//! dispatched indirectly, batches of steps submitted with their control words read back
+//! while the next batch runs (`advance`), and what a halt reports.
+
+use super::*;
+
+/// Steps encoded into one submission at most. Between submissions the host reads the
+/// control words (divergence check, progress).
+pub const STEPS_PER_SUBMIT: u64 = 64;
+
+/// Batches of steps in flight at most (`GpuSimulation::advance`): the host encodes and
+/// submits one while the device runs the other.
+pub const BATCHES_IN_FLIGHT: usize = 2;
+
+/// A submitted batch of steps: its submission and the staging buffer its control words
+/// are copied to.
+pub(super) struct Batch {
+    pub(super) staging: wgpu::Buffer,
+    pub(super) index: wgpu::SubmissionIndex,
+    pub(super) steps: u64,
+}
+
+/// The stages of a rebuild of the neighbour lists, in order: the old lists' springs into
+/// the table, the cell list, the new memory order, the new lists and their springs. A
+/// step dispatches them indirectly (`plan_rebuild`, shaders/plan.wgsl).
+pub const REBUILD_STAGES: [Kernel; 16] = {
+    let c = GpuSimulation::CELL_LIST;
+    [
+        Kernel::ClearTable,
+        Kernel::StoreHistory,
+        c[0],
+        c[1],
+        c[2],
+        c[3],
+        c[4],
+        c[5],
+        c[6],
+        c[7],
+        c[8],
+        c[9],
+        Kernel::PermuteGather,
+        Kernel::PermuteStore,
+        Kernel::FindContacts,
+        Kernel::GatherHistory,
+    ]
+};
+
+/// What a step encodes besides its fixed stages.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct StepKind {
+    /// Sources still have candidates: the insertion kernels run first.
+    pub(super) sources_left: bool,
+    /// Store the contacts' outputs (the last step of an `advance`, which `download`
+    /// reads).
+    pub(super) record: bool,
+    /// Gear: the step before predicted this one already (`Kernel::CorrectAhead`).
+    pub(super) predicted: bool,
+    /// Gear: predict the next step at the end of this one.
+    pub(super) ahead: bool,
+}
+
+/// One indirect dispatch's arguments in `dispatch_args`: x, y, z and a word of padding.
+pub(super) const DISPATCH_ARGS_BYTES: usize = 16;
+
+/// The workgroups of one dispatch of kernel k.
+pub fn workgroups(p: &Params, k: Kernel) -> u64 {
+    match k {
+        Kernel::InsertPlace | Kernel::ScanLevel2 | Kernel::AdvanceClock | Kernel::PlanRebuild => 1,
+        // Grid-stride loops: as many workgroups as one dispatch takes.
+        Kernel::ClearCells => ceil_div(p.cells.max(p.n_cap) as u64, WG as u64).min(MAX_WORKGROUPS),
+        Kernel::ClearCursor => ceil_div(p.cells as u64, WG as u64),
+        Kernel::ScanLevel0 | Kernel::ScanAdd0 => p.scan_blocks1 as u64,
+        Kernel::ScanLevel1 | Kernel::ScanAdd1 => p.scan_blocks2 as u64,
+        Kernel::ClearTable => ceil_div(p.table_mask as u64 + 1, WG as u64).min(MAX_WORKGROUPS),
+        _ => ceil_div(p.n_cap as u64, WG as u64),
+    }
+    .max(1)
+}
+
+/// The contents of `dispatch_args` at the upload: each rebuild stage's workgroups, then
+/// room for a step's arguments (shaders/plan.wgsl).
+pub(super) fn dispatch_args(p: &Params) -> Vec<u32> {
+    let mut args: Vec<u32> = REBUILD_STAGES
+        .iter()
+        .flat_map(|&k| [workgroups(p, k) as u32, 1, 1, 0])
+        .collect();
+    args.resize(2 * args.len(), 0);
+    args
+}
+
+/// What the GPU path has encoded and submitted since the upload (`talus bench`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Counters {
+    /// Dispatches with a workgroup count fixed when encoded.
+    pub direct: u64,
+    /// Indirect dispatches: the rebuild stages, which run workgroups only at a rebuild.
+    pub indirect: u64,
+    /// Submissions: batches of steps and readbacks.
+    pub submissions: u64,
+    /// Rebuilds of the neighbour lists (each runs the `REBUILD_STAGES.len()` indirect
+    /// dispatches of its step).
+    pub rebuilds: u64,
+}
+
+impl GpuSimulation {
+    /// What has been encoded and submitted since the upload (reads the rebuild count
+    /// back).
+    pub fn counters(&self) -> Counters {
+        Counters {
+            direct: self.dispatches.get(),
+            indirect: self.indirect.get(),
+            submissions: self.submissions.get(),
+            rebuilds: self.rebuilds(),
+        }
+    }
+
+    pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, k: Kernel, groups: u64) {
+        self.dispatches.set(self.dispatches.get() + 1);
+        pass.set_pipeline(&self.pipelines.pipelines[&k]);
+        pass.dispatch_workgroups(groups.max(1) as u32, 1, 1);
+    }
+
+    /// Sets every bind group of the talus kernels on a pass.
+    pub(super) fn bind_groups(&self, pass: &mut wgpu::ComputePass) {
+        pass.set_bind_group(0, &self.group0, &[]);
+        pass.set_bind_group(1, &self.group1, &[]);
+        pass.set_bind_group(2, &self.group2, &[]);
+    }
+
+    /// Records the dispatches of one kernel (for tests of single stages).
+    pub fn encode_kernel(&self, pass: &mut wgpu::ComputePass, k: Kernel) {
+        self.dispatch(pass, k, workgroups(&self.params, k));
+    }
+
+    /// Records a rebuild stage (the `REBUILD_STAGES[stage]`), dispatched with the
+    /// workgroups `plan_rebuild` wrote for this step: none between rebuilds.
+    pub(super) fn dispatch_rebuild_stage(&self, pass: &mut wgpu::ComputePass, stage: usize) {
+        self.indirect.set(self.indirect.get() + 1);
+        let k = REBUILD_STAGES[stage];
+        pass.set_pipeline(&self.pipelines.pipelines[&k]);
+        let offset = (REBUILD_STAGES.len() + stage) * DISPATCH_ARGS_BYTES;
+        pass.dispatch_workgroups_indirect(&self.buffers.dispatch_args, offset as u64);
+    }
+
+    /// Runs one kernel with a given number of workgroups (tests of the grid-stride
+    /// loops, which must cover everything from any number of workgroups).
+    pub fn run_kernel_with_groups(&mut self, k: Kernel, groups: u64) {
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            self.bind_groups(&mut pass);
+            self.dispatch(&mut pass, k, groups);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.synced = false;
+    }
+
+    /// Runs some kernels once, in order, in one submission (tests of single stages).
+    pub fn run_kernels(&mut self, ks: &[Kernel]) {
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            self.bind_groups(&mut pass);
+            for &k in ks {
+                self.encode_kernel(&mut pass, k);
+            }
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.synced = false;
+    }
+
+    /// The kernels of the cell list, in order.
+    pub const CELL_LIST: [Kernel; 10] = [
+        Kernel::ClearCells,
+        Kernel::CellIndex,
+        Kernel::CellHistogram,
+        Kernel::ScanLevel0,
+        Kernel::ScanLevel1,
+        Kernel::ScanLevel2,
+        Kernel::ScanAdd1,
+        Kernel::ScanAdd0,
+        Kernel::ClearCursor,
+        Kernel::Scatter,
+    ];
+
+    /// One time step, stage by stage as in `Simulation::step`.
+    pub(super) fn encode_step(&self, pass: &mut wgpu::ComputePass, how: StepKind) {
+        if how.sources_left {
+            self.encode_kernel(pass, Kernel::InsertCheck);
+            self.encode_kernel(pass, Kernel::InsertPlace);
+        }
+        let gear = self.params.integrator == 0;
+        // The neighbour lists (issue 13): the survey decides whether this step rebuilds
+        // them (the stages of a rebuild: the old lists' springs into the table, the cell
+        // list, the memory order, the new lists, their springs from the table). Gear's
+        // prediction surveys each particle it predicts; the step before may have run it
+        // ahead.
+        if !gear {
+            self.encode_kernel(pass, Kernel::Survey);
+        } else if !how.predicted {
+            self.encode_kernel(pass, Kernel::Predict);
+        }
+        // Between rebuilds the rebuild stages are dispatched with no workgroups (issue 14
+        // item 2): `plan_rebuild` writes their arguments once the survey has decided.
+        self.encode_kernel(pass, Kernel::PlanRebuild);
+        for stage in 0..REBUILD_STAGES.len() {
+            self.dispatch_rebuild_stage(pass, stage);
+        }
+        self.encode_kernel(
+            pass,
+            if how.record {
+                Kernel::ContactForces
+            } else {
+                Kernel::ContactForcesOnly
+            },
+        );
+        self.encode_kernel(
+            pass,
+            match (gear, how.ahead) {
+                (true, false) => Kernel::Correct,
+                (true, true) => Kernel::CorrectAhead,
+                (false, _) => Kernel::KickDrift,
+            },
+        );
+        // (The integrators' kernels sum each particle's forces first and end with the
+        // boundaries.)
+        self.encode_kernel(pass, Kernel::AdvanceClock);
+    }
+
+    /// Whether candidates are still waiting: every particle created on the device comes
+    /// from a source, and the buffers were sized for all of them.
+    pub(super) fn sources_left(&self) -> bool {
+        self.live < self.n_cap && !self.sources.is_empty()
+    }
+
+    /// Advances `steps` steps, `STEPS_PER_SUBMIT` per submission. Submissions are
+    /// pipelined (issue 14 item 3): each batch copies the control words into its own
+    /// staging buffer, and the host reads them only once the next batch is submitted, so
+    /// the device always has work queued and the host never waits on an idle device. A
+    /// halt stops every later kernel on the device at once (each returns when `halted`),
+    /// so a batch submitted after the halting one changes nothing, and the halt still
+    /// names its step.
+    pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
+        let sources_left = self.sources_left();
+        // Gear's prediction runs ahead at the end of the step before (`CorrectAhead`, as
+        // the CPU path's `correct_ahead`) when the device goes on at once: not across an
+        // insertion (new particles are predicted in their step), nor into a stop (the end
+        // of the advance, a layered row: the host reads a corrected state).
+        let can_run_ahead = self.params.integrator == 0 && !sources_left;
+        let mut predicted = false;
+        let mut left = steps;
+        let mut in_flight: std::collections::VecDeque<Batch> = Default::default();
+        // The step the device reaches once the batches in flight are done.
+        let mut planned = self.step;
+        while left > 0 || !in_flight.is_empty() {
+            if left > 0 && in_flight.len() < BATCHES_IN_FLIGHT {
+                let mut k = left.min(STEPS_PER_SUBMIT);
+                // Submissions stop where a layered row is due; the host lays it once the
+                // device has caught up.
+                match self.next_layered_step(planned) {
+                    Some(due) if due == planned && in_flight.is_empty() => {
+                        self.place_layered_rows();
+                        // The next row may be due within this batch.
+                        continue;
+                    }
+                    Some(due) if due == planned => k = 0,
+                    Some(due) => k = k.min(due - planned),
+                    None => {}
+                }
+                if k > 0 {
+                    let last = k == left;
+                    let stops = last || self.next_layered_step(planned + k) == Some(planned + k);
+                    let how = StepKind {
+                        sources_left,
+                        record: false,
+                        predicted,
+                        ahead: can_run_ahead,
+                    };
+                    in_flight.push_back(self.submit_batch(k, how, last, stops));
+                    predicted = can_run_ahead && !stops;
+                    planned += k;
+                    left -= k;
+                    continue;
+                }
+            }
+            let batch = in_flight.pop_front().expect("a batch in flight");
+            let done = batch.steps;
+            let c = self.wait_for(batch);
+            self.live = c[control::LIVE];
+            self.lost_now = c[control::LOST] as u64;
+            if c[control::HALT] != 0 {
+                // The later batches ran as no-ops; let them finish first.
+                for b in in_flight.drain(..) {
+                    self.wait_for(b);
+                }
+                return Err(self.halt_cause(&c));
+            }
+            self.step += done;
+        }
+        Ok(())
+    }
+
+    /// Encodes and submits `k` steps, with a copy of the control words at their end.
+    /// `how`: its first step (and whether steps may predict ahead); `last`: the batch
+    /// ends the `advance`, its last step records the contacts; `stops`: the device stops
+    /// after it (the end, a layered row), its last step does not predict ahead.
+    pub(super) fn submit_batch(
+        &mut self,
+        k: u64,
+        first: StepKind,
+        last: bool,
+        stops: bool,
+    ) -> Batch {
+        let words = control::BLOCKED;
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("control readback"),
+            size: (words * 4) as u64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            self.bind_groups(&mut pass);
+            let mut how = first;
+            for step in 1..=k {
+                let end = step == k;
+                let ahead = first.ahead && !(end && stops);
+                how.record = last && end;
+                how.ahead = ahead;
+                self.encode_step(&mut pass, how);
+                how.predicted = ahead;
+            }
+        }
+        enc.copy_buffer_to_buffer(&self.buffers.control, 0, &staging, 0, (words * 4) as u64);
+        let index = self.gpu.queue.submit([enc.finish()]);
+        staging
+            .slice(..)
+            .map_async(wgpu::MapMode::Read, |r| r.expect("GPU readback failed"));
+        self.submissions.set(self.submissions.get() + 1);
+        self.synced = false;
+        Batch {
+            staging,
+            index,
+            steps: k,
+        }
+    }
+
+    /// Waits until a batch is done and returns the control words it left.
+    pub(super) fn wait_for(&self, batch: Batch) -> Vec<u32> {
+        self.gpu
+            .device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(batch.index),
+                timeout: None,
+            })
+            .expect("GPU device lost");
+        let view = batch.staging.slice(..).get_mapped_range().expect("mapped");
+        bytemuck::cast_slice::<u8, u32>(&view[..]).to_vec()
+    }
+
+    pub(super) fn halt_cause(&mut self, c: &[u32]) -> Divergence {
+        // The device stopped inside the last submission, at the start of step
+        // `halt_step`; the steps before it completed.
+        let halt_step = c[control::HALT_STEP] as u64;
+        self.step = halt_step;
+        let id = c[control::HALT_ID];
+        let flags = c[control::HALT];
+        self.download();
+        self.sim.step = halt_step;
+        if flags & control::HALT_OVERLAP != 0 {
+            let limit = self.sim.scene.limits.max_overlap;
+            // The halting step recorded the diverging contacts (contact_forces.wgsl); the
+            // others' records are older and within the limit.
+            let mut worst: Option<(u32, f64)> = None;
+            for (p, cf) in self.sim.pairs.iter().zip(&self.sim.contacts) {
+                if p.i != id {
+                    continue;
+                }
+                let ri = self.sim.particles.radius[p.i as usize];
+                let rmin = if p.is_wall() {
+                    ri
+                } else {
+                    ri.min(self.sim.particles.radius[p.j as usize])
+                };
+                let ratio = cf.overlap / rmin;
+                if worst.is_none_or(|(_, r)| ratio > r) {
+                    worst = Some((p.j, ratio));
+                }
+            }
+            let (j, ratio) = worst.unwrap_or((u32::MAX, f64::NAN));
+            let j = if j >= WALL_BASE && j != u32::MAX {
+                format!("wall {}", j - WALL_BASE)
+            } else {
+                j.to_string()
+            };
+            return Divergence::Overlap {
+                i: id,
+                j,
+                ratio,
+                limit,
+            };
+        }
+        if flags & control::HALT_NOT_FINITE != 0 {
+            return Divergence::NotFinite {
+                id,
+                what: "force or position",
+            };
+        }
+        if flags & control::HALT_CONTACTS_FULL != 0 {
+            return Divergence::TooManyContacts {
+                id,
+                max: MAX_CONTACTS,
+            };
+        }
+        Divergence::SpringTableFull { id }
+    }
+
+    pub(super) fn read_control(&self) -> Vec<u32> {
+        let words = control::BLOCKED;
+        self.read_buffer::<u32>(&self.buffers.control, 0, words)
+    }
+}
+
+/// The control words at the upload: the step, the particles, no halt, and the first
+/// step builds the lists with the springs of the table uploaded with them.
+pub(super) fn initial_control(step: u64, live: u32, sources: usize) -> Vec<u32> {
+    let mut control = vec![0u32; control::BLOCKED + (sources * INSERT_WINDOW as usize).max(1)];
+    control[control::STEP] = step as u32;
+    control[control::LIVE] = live;
+    control[control::HALT_STEP] = u32::MAX;
+    control[control::HALT_ID] = u32::MAX;
+    control[control::LISTS] = control::REBUILD | control::TABLE_CURRENT;
+    control
+}

@@ -1,0 +1,524 @@
+//! Between host and device: the f64 state to the device's fixed-point layout and back,
+//! readback of the device state into the host mirror (`download`, `device_state`), the
+//! spring table, and the access the tests of single kernels use.
+
+use super::*;
+
+/// Per-slot values of the device put in id order (`ids`: each slot's id).
+pub(super) fn by_id<T: Copy>(ids: &[u32], slots: Vec<T>) -> Vec<T> {
+    let mut out = slots.clone();
+    for (&id, v) in ids.iter().zip(slots) {
+        out[id as usize] = v;
+    }
+    out
+}
+
+/// A wall's line normal n = (−t_z, t_x) (t along a → b) in Q30 integers q, and how q is
+/// off n: q = (1 + α) n + β t, from the f64 end points. With them `wall_line`
+/// (geometry.wgsl) measures distances from any line, long and inclined, exactly in
+/// integers plus α (up to 2⁻³¹) times the distance and β times the distance along it.
+pub(super) fn wall_normal(w: &crate::geometry::WallSegment) -> ([i32; 2], f32, f32) {
+    let ab = [w.b[0] - w.a[0], w.b[1] - w.a[1]];
+    let len = ab[0].hypot(ab[1]).max(f64::MIN_POSITIVE);
+    let t = [ab[0] / len, ab[1] / len];
+    let n = [-t[1], t[0]];
+    let q30 = (1u64 << 30) as f64;
+    let nq = [(n[0] * q30).round() as i32, (n[1] * q30).round() as i32];
+    let q = [nq[0] as f64 / q30, nq[1] as f64 / q30];
+    let beta = q[0] * t[0] + q[1] * t[1];
+    let alpha = q[0] * n[0] + q[1] * n[1] - 1.0;
+    (nq, beta as f32, alpha as f32)
+}
+
+/// The device's corner buffer: every corner in whole position units, body frame in xy
+/// and rotated to its particle's orientation in zw (as `rotate_corners` in
+/// orientation.wgsl; a candidate's are rotated when it is placed).
+pub(super) fn device_corners(
+    table: &[[f64; 2]],
+    states: &[State],
+    props: &[Props],
+    unit: f64,
+) -> Vec<[i32; 4]> {
+    let mut out: Vec<[i32; 4]> = table
+        .iter()
+        .map(|&v| {
+            let b = orientation::corner_units(v, unit);
+            [b[0], b[1], b[0], b[1]]
+        })
+        .collect();
+    for (s, p) in states.iter().zip(props) {
+        let sc = orientation::turn_sin_cos(s.turn);
+        let [start, count] = p.shape;
+        for c in &mut out[start as usize..(start + count) as usize] {
+            let w = orientation::rotate_units([c[0], c[1]], sc);
+            c[2] = w[0];
+            c[3] = w[1];
+        }
+    }
+    out
+}
+
+/// One particle's props with its corners counted from 0 (for `device_corners` on a
+/// table of its own corners).
+pub(super) fn pr_local(p: &Props) -> [Props; 1] {
+    [Props {
+        shape: [0, p.shape[1]],
+        ..*p
+    }]
+}
+
+/// Where each particle's corners start in the corner buffer: particles in id order.
+pub fn corner_starts(p: &Particles) -> Vec<u32> {
+    p.shape
+        .iter()
+        .scan(0u32, |next, c| {
+            let start = *next;
+            *next += c.len() as u32;
+            Some(start)
+        })
+        .collect()
+}
+
+/// Host f64 particles → device layout.
+pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec<Props>) {
+    let mut states = Vec::with_capacity(p.len());
+    let mut props = Vec::with_capacity(p.len());
+    let starts = corner_starts(p);
+    for i in 0..p.len() {
+        let q0 = p.q[0][i];
+        let (anchor, frac, rem) = position::split2(q0[0] - origin[0], q0[1] - origin[1], cell);
+        let mut s = State {
+            anchor,
+            frac,
+            ..Default::default()
+        };
+        let (turn, turn_rem) = orientation::split_angle(q0[2]);
+        s.turn = turn;
+        s.q[0] = [rem[0], rem[1], turn_rem, 0.0];
+        for k in 1..GEAR_VALUES {
+            let v = p.q[k][i];
+            s.q[k] = [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
+        }
+        states.push(s);
+        let flags =
+            ((p.active[i] as u32) * ACTIVE) | ((p.fixed[i] as u32) * FIXED) | (p.material[i] << 8);
+        let (radius_units, radius_rem) = position::length_units(p.radius[i], cell);
+        props.push(Props {
+            radius: p.radius[i] as f32,
+            mass: p.mass[i] as f32,
+            inv_inertia: (1.0 / p.inertia[i]) as f32,
+            flags,
+            radius_units,
+            radius_rem,
+            shape: [starts[i], p.shape[i].len() as u32],
+        });
+    }
+    (states, props)
+}
+
+/// Device layout → host f64 particles.
+pub fn from_device(
+    states: &[State],
+    props: &[Props],
+    origin: [f64; 2],
+    cell: f32,
+    corner_table: &[[f64; 2]],
+) -> Particles {
+    let mut p = Particles::default();
+    for (s, pr) in states.iter().zip(props) {
+        let coord = |k: usize| {
+            let f = position::Fixed {
+                anchor: s.anchor[k],
+                frac: s.frac[k],
+                rem: s.q[0][k],
+            };
+            origin[k] + position::join(f, cell)
+        };
+        let theta = orientation::join_angle(s.turn, s.q[0][2]);
+        p.q[0].push([coord(0), coord(1), theta]);
+        for k in 1..GEAR_VALUES {
+            let v = s.q[k];
+            p.q[k].push([v[0] as f64, v[1] as f64, v[2] as f64]);
+        }
+        p.radius
+            .push((pr.radius_units as f64 + pr.radius_rem as f64) * position::unit(cell));
+        p.mass.push(pr.mass as f64);
+        p.inertia.push(if pr.inv_inertia == 0.0 {
+            f64::INFINITY
+        } else {
+            1.0 / pr.inv_inertia as f64
+        });
+        p.fixed.push(pr.flags & FIXED != 0);
+        p.active.push(pr.flags & ACTIVE != 0);
+        p.material.push(pr.flags >> 8);
+        let [start, count] = pr.shape;
+        p.shape
+            .push(corner_table[start as usize..(start + count) as usize].to_vec());
+    }
+    p
+}
+
+/// A spring table laid out as the kernels expect (host twin of `insert_new`).
+pub fn build_table(entries: &[Entry], cap: usize) -> Vec<Entry> {
+    let empty = Entry {
+        i: EMPTY,
+        ..Default::default()
+    };
+    let mut t = vec![empty; cap];
+    let mask = cap - 1;
+    for e in entries {
+        let mut slot = hash_pair(e.i, e.j) as usize & mask;
+        while t[slot].i != EMPTY {
+            slot = (slot + 1) & mask;
+        }
+        t[slot] = *e;
+    }
+    t
+}
+
+/// Looks a pair up in a device-layout table (host twin of `lookup_old`).
+pub fn table_lookup(table: &[Entry], i: u32, j: u32) -> Option<f32> {
+    let mask = table.len() - 1;
+    let mut slot = hash_pair(i, j) as usize & mask;
+    for _ in 0..table.len() {
+        let e = table[slot];
+        if e.i == EMPTY {
+            return None;
+        }
+        if e.i == i && e.j == j {
+            return Some(e.value);
+        }
+        slot = (slot + 1) & mask;
+    }
+    None
+}
+
+impl GpuSimulation {
+    /// Copies `count` elements of type T from a buffer (blocking).
+    pub(super) fn read_buffer<T: bytemuck::Pod>(
+        &self,
+        buf: &wgpu::Buffer,
+        first: usize,
+        count: usize,
+    ) -> Vec<T> {
+        let size = size_of::<T>() as u64;
+        let bytes = (count as u64 * size).next_multiple_of(4);
+        if bytes == 0 {
+            return Vec::new();
+        }
+        let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        enc.copy_buffer_to_buffer(buf, first as u64 * size, &staging, 0, bytes);
+        self.gpu.queue.submit([enc.finish()]);
+        self.submissions.set(self.submissions.get() + 1);
+        let slice = staging.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |r| r.expect("GPU readback failed"));
+        self.gpu
+            .device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .expect("GPU device lost");
+        let view = slice.get_mapped_range().expect("mapped");
+        let out = bytemuck::cast_slice::<u8, T>(&view[..count * size as usize]).to_vec();
+        drop(view);
+        staging.unmap();
+        out
+    }
+
+    pub(super) fn write_buffer<T: bytemuck::Pod>(&mut self, buf: &wgpu::Buffer, data: &[T]) {
+        self.gpu
+            .queue
+            .write_buffer(buf, 0, bytemuck::cast_slice(data));
+        self.synced = false;
+    }
+
+    /// Reads the device state into the host mirror `self.sim` (f64 particles, this step's
+    /// contacts and forces, the spring table, source progress, step and losses).
+    pub fn download(&mut self) -> &Simulation {
+        if self.synced {
+            return &self.sim;
+        }
+        let c = self.read_control();
+        let live = c[control::LIVE] as usize;
+        self.live = live as u32;
+        let ds = self.device_state();
+        let cell = self.params.cell_size;
+        let p = from_device(&ds.states, &ds.props, self.origin, cell, &self.corner_table);
+        self.sim.particles = p;
+        self.sim.step = self.step;
+        self.sim.lost = self.lost_base + c[control::LOST] as u64;
+        let mut table = SpringTable::with_capacity_for(ds.springs.len());
+        for e in &ds.springs {
+            table.insert(pair_key(Pair { i: e.i, j: e.j }), e.value as f64);
+        }
+        self.sim.springs = table;
+        let rows: Vec<Source> = self.read_buffer(&self.buffers.sources, 0, self.sources.len());
+        // Point sources advance on the device; layered blocks (after them) on the host.
+        for (k, (b, r)) in self.sources.iter().zip(&rows).enumerate() {
+            self.sim.sources[k] = source::advanced(&b.spec, &b.state, r.inserted);
+        }
+        // This step's contacts, in the CPU's order (by i, then j, ids; walls last).
+        let m = MAX_CONTACTS as usize;
+        let ids: Vec<u32> = self.read_buffer(&self.buffers.ids, 0, live);
+        let key = |j: u32| if j >= WALL_BASE { j } else { ids[j as usize] };
+        let count: Vec<u32> = self.read_buffer(&self.buffers.contact_count, 0, live);
+        let js: Vec<u32> = self.read_buffer(&self.buffers.contact_j, 0, live * m);
+        let outs = self.read_contact_out(live * m);
+        let touching: Vec<u32> = self.read_buffer(&self.buffers.touching, 0, live * m);
+        let mut listed = Vec::new();
+        // Every contact as the device computed it: its force, normal and contact point
+        // (relative to i's centre), converted exactly from f32 (issue 19).
+        let parts = &self.sim.particles;
+        for s in 0..live {
+            // The lists' candidates that touch: the contacts.
+            for k in (0..count[s] as usize).filter(|&k| touching[s * m + k] != 0) {
+                let (i, j) = (ids[s], key(js[s * m + k]));
+                let o = outs[s * m + k];
+                let p = parts.position(i as usize);
+                let arm = [o.geo[2] as f64, o.geo[3] as f64];
+                let pair = Pair { i, j };
+                listed.push((
+                    pair,
+                    ContactForce {
+                        force: [o.ft[0] as f64, o.ft[1] as f64],
+                        // contact_out holds the torque on j; ContactForce the torque of F
+                        // about j's centre.
+                        torque: [o.ft[2] as f64, -(o.ft[3] as f64)],
+                        point: [p[0] + arm[0], p[1] + arm[1]],
+                        arm,
+                        n: [o.geo[0] as f64, o.geo[1] as f64],
+                        f_n: o.info[0] as f64,
+                        f_t: o.info[1] as f64,
+                        overlap: o.info[2] as f64,
+                        energy: o.info[3] as f64,
+                    },
+                ));
+            }
+        }
+        listed.sort_by_key(|(p, _)| (p.i, p.j));
+        let (pairs, contacts) = listed.into_iter().unzip();
+        self.sim.pairs = pairs;
+        self.sim.contacts = contacts;
+        self.sim.device_state = Some(ds);
+        self.synced = true;
+        &self.sim
+    }
+
+    /// The exact device state (for checkpoints).
+    pub fn device_state(&self) -> DeviceState {
+        let live = self.read_control()[control::LIVE] as usize;
+        // In id order, whatever the memory order on the device.
+        let ids: Vec<u32> = self.read_buffer(&self.buffers.ids, 0, live);
+        let mut states: Vec<State> = by_id(&ids, self.read_buffer(&self.buffers.state, 0, live));
+        // Where each particle was at the last rebuild belongs to the lists, not to the
+        // state: an upload rebuilds them (and a resumed run may rebuild on other steps).
+        for s in &mut states {
+            s.listed_anchor = 0;
+            s.listed_frac = [0; 2];
+        }
+        let props = by_id(&ids, self.read_buffer(&self.buffers.props, 0, live));
+        let cap = self.params.table_mask as usize + 1;
+        self.flush_table();
+        let table: Vec<Entry> = self.read_buffer(&self.buffers.table, 0, cap);
+        let mut springs: Vec<Entry> = table.into_iter().filter(|e| e.i != EMPTY).collect();
+        springs.sort_by_key(|e| (e.i, e.j));
+        DeviceState {
+            states,
+            props,
+            springs,
+        }
+    }
+
+    /// Overwrites the particle state on the device (tests).
+    pub fn upload_particles(&mut self, p: &Particles) {
+        let (s, pr) = to_device(p, self.origin, self.params.cell_size);
+        let s_buf = self.buffers.state.clone();
+        let p_buf = self.buffers.props.clone();
+        let ids_buf = self.buffers.ids.clone();
+        self.write_buffer(&s_buf, &s);
+        self.write_buffer(&p_buf, &pr);
+        self.write_buffer(&ids_buf, &(0..s.len() as u32).collect::<Vec<_>>());
+    }
+
+    /// Whether rebuilds sort the particles in memory by cell (default: yes). No result
+    /// depends on it (tests compare both).
+    pub fn set_reorder(&mut self, reorder: bool) {
+        self.params.reorder = reorder as u32;
+        let params = self.params;
+        self.gpu
+            .queue
+            .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&params));
+    }
+
+    /// Makes the spring table hold the springs of the current lists (those of the
+    /// candidates that touched at the last step), unless it already holds the springs
+    /// (nothing has run since an upload). Between steps the springs live in the lists'
+    /// slots; the table is written only at a rebuild (issue 13).
+    pub(super) fn flush_table(&self) {
+        let flags = self.read_control()[control::LISTS];
+        if flags & control::TABLE_CURRENT != 0 {
+            return;
+        }
+        self.write_lists_word(control::FLUSH);
+        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
+        {
+            let mut pass = enc.begin_compute_pass(&Default::default());
+            self.bind_groups(&mut pass);
+            self.encode_kernel(&mut pass, Kernel::ClearTable);
+            self.encode_kernel(&mut pass, Kernel::StoreHistory);
+        }
+        self.gpu.queue.submit([enc.finish()]);
+        self.write_lists_word(flags);
+    }
+
+    pub(super) fn write_lists_word(&self, flags: u32) {
+        self.gpu.queue.write_buffer(
+            &self.buffers.control,
+            (control::LISTS * 4) as u64,
+            bytemuck::bytes_of(&flags),
+        );
+    }
+
+    /// Sets the neighbour lists' word (`control::REBUILD`, …; tests of single kernels).
+    pub fn set_list_flags(&mut self, flags: u32) {
+        self.write_lists_word(flags);
+        self.synced = false;
+    }
+
+    /// Overwrites the spring table (tests); the next rebuild takes its springs from it.
+    pub fn upload_springs(&mut self, entries: &[Entry]) {
+        let table = build_table(entries, self.params.table_mask as usize + 1);
+        let buf = self.buffers.table.clone();
+        self.write_buffer(&buf, &table);
+        self.set_list_flags(control::REBUILD | control::TABLE_CURRENT);
+    }
+
+    /// Overwrites the lists and their springs, every candidate touching (tests).
+    pub fn upload_contacts(&mut self, count: &[u32], js: &[u32], history: &[f32]) {
+        let (a, b, c, d) = (
+            self.buffers.contact_count.clone(),
+            self.buffers.contact_j.clone(),
+            self.buffers.hist_in.clone(),
+            self.buffers.touching.clone(),
+        );
+        self.write_buffer(&a, count);
+        self.write_buffer(&b, js);
+        self.write_buffer(&c, history);
+        self.write_buffer(&d, &vec![1u32; js.len()]);
+    }
+
+    pub fn upload_cell_counts(&mut self, counts: &[u32]) {
+        let buf = self.buffers.cell_count.clone();
+        self.write_buffer(&buf, counts);
+    }
+
+    /// Reads a named per-step buffer as u32 words (tests).
+    pub fn read_u32(&self, name: &str, count: usize) -> Vec<u32> {
+        let b = &self.buffers;
+        let buf = match name {
+            "cell_of" => &b.cell_of,
+            "cell_count" => &b.cell_count,
+            "cell_start" => &b.cell_start,
+            "sorted" => &b.sorted,
+            "ids" => &b.ids,
+            "contact_j" => &b.contact_j,
+            "contact_count" => &b.contact_count,
+            "touching" => &b.touching,
+            "table" => &b.table,
+            "control" => &b.control,
+            "dispatch_args" => &b.dispatch_args,
+            _ => panic!("unknown buffer {name}"),
+        };
+        self.read_buffer(buf, 0, count)
+    }
+
+    pub fn read_f32(&self, name: &str, count: usize) -> Vec<f32> {
+        let b = &self.buffers;
+        let buf = match name {
+            "hist_in" => &b.hist_in,
+            _ => panic!("unknown buffer {name}"),
+        };
+        self.read_buffer(buf, 0, count)
+    }
+
+    pub fn read_forces(&self, count: usize) -> Vec<[f32; 4]> {
+        self.read_buffer(&self.buffers.force, 0, count)
+    }
+
+    pub fn read_contact_out(&self, count: usize) -> Vec<ContactOut> {
+        let b = &self.buffers;
+        let ft: Vec<[f32; 4]> = self.read_buffer(&b.contact_ft, 0, count);
+        let info: Vec<[f32; 4]> = self.read_buffer(&b.contact_info, 0, count);
+        let geo: Vec<[f32; 4]> = self.read_buffer(&b.contact_geo, 0, count);
+        (ft.into_iter().zip(info).zip(geo))
+            .map(|((ft, info), geo)| ContactOut { ft, info, geo })
+            .collect()
+    }
+}
+
+/// The walls in the device's layout: both ends in fixed point, the exact normal.
+pub(super) fn device_walls(
+    walls: &[crate::geometry::WallSegment],
+    origin: [f64; 2],
+    cell_size: f32,
+) -> Vec<Wall> {
+    walls
+        .iter()
+        .map(|w| {
+            let (a_anchor, a_frac, a_rem) =
+                position::split2(w.a[0] - origin[0], w.a[1] - origin[1], cell_size);
+            let (b_anchor, b_frac, b_rem) =
+                position::split2(w.b[0] - origin[0], w.b[1] - origin[1], cell_size);
+            let (nq, beta, alpha) = wall_normal(w);
+            Wall {
+                a_anchor,
+                a_frac,
+                a_rem,
+                b_anchor,
+                b_frac,
+                b_rem,
+                ab: [(w.b[0] - w.a[0]) as f32, (w.b[1] - w.a[1]) as f32],
+                nq,
+                beta,
+                alpha,
+            }
+        })
+        .collect()
+}
+
+/// The particles and springs to upload: a GPU checkpoint's exact device state, else the
+/// f64 state and spring table converted.
+pub(super) fn initial_state(
+    sim: &Simulation,
+    device_state: Option<DeviceState>,
+    origin: [f64; 2],
+    cell_size: f32,
+) -> (Vec<State>, Vec<Props>, Vec<Entry>) {
+    match device_state {
+        Some(mut ds) => {
+            // The corner buffer is laid out afresh: point each particle at its corners.
+            for (pr, start) in ds.props.iter_mut().zip(corner_starts(&sim.particles)) {
+                pr.shape[0] = start;
+            }
+            (ds.states, ds.props, ds.springs)
+        }
+        None => {
+            let (s, p) = to_device(&sim.particles, origin, cell_size);
+            let e = sim
+                .spring_table()
+                .entries()
+                .map(|(k, v)| Entry {
+                    i: (k >> 32) as u32,
+                    j: k as u32,
+                    value: v as f32,
+                    _pad: 0,
+                })
+                .collect();
+            (s, p, e)
+        }
+    }
+}
