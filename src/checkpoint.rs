@@ -4,6 +4,7 @@
 
 use crate::create::source::SourceState;
 use crate::files::{Decoder, Encoder, write_atomic};
+use crate::gpu::DeviceState;
 use crate::rng::Rng;
 use crate::sim::Simulation;
 use crate::springs::SpringTable;
@@ -32,7 +33,7 @@ pub enum CheckpointError {
     Scene(String, crate::scene::SceneError),
 }
 
-pub fn encode(sim: &Simulation) -> Vec<u8> {
+pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
     let mut e = Encoder::default();
     e.bytes.extend_from_slice(MAGIC);
     e.str(&serde_json::to_string(&sim.scene).expect("a scene always serialises"));
@@ -76,7 +77,7 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
     // From a GPU run: the exact device state, for a bitwise GPU resume. The flag is the
     // device layout's version (1: f32 offsets before fixed point, 2: f32 orientations;
     // neither is read any more).
-    match &sim.device_state {
+    match device {
         Some(ds) => {
             e.u8(DEVICE_LAYOUT);
             for raw in [
@@ -93,14 +94,28 @@ pub fn encode(sim: &Simulation) -> Vec<u8> {
     e.bytes
 }
 
-pub fn write(sim: &Simulation, path: &Path) -> std::io::Result<()> {
-    write_atomic(path, &encode(sim))
+pub fn write(sim: &Simulation, device: Option<&DeviceState>, path: &Path) -> std::io::Result<()> {
+    write_atomic(path, &encode(sim, device))
+}
+
+/// What a checkpoint holds: the f64 state, and from a GPU run the exact device state (a
+/// GPU run resumes from it bitwise; the CPU path continues from the f64 state).
+pub struct Checkpoint {
+    pub sim: Simulation,
+    pub device: Option<DeviceState>,
+}
+
+impl Checkpoint {
+    /// A start from a scene: no device state.
+    pub fn fresh(sim: Simulation) -> Self {
+        Self { sim, device: None }
+    }
 }
 
 /// Loads a checkpoint; `overrides` may change `stop.*`, `output.*` (so a run can be
 /// extended) and `skin` (which changes only the speed), since anything else would break
 /// the continuation.
-pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointError> {
+pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointError> {
     let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| CheckpointError::Io(name.clone(), e))?;
     if bytes.len() >= 8 && &bytes[..8] == OLD_MAGIC {
@@ -224,7 +239,7 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
         } else if !sizes_ok {
             return Err(corrupt(crate::files::DecodeError(bytes.len())));
         } else {
-            Some(crate::gpu::DeviceState {
+            Some(DeviceState {
                 states: bytemuck::pod_collect_to_vec(states),
                 props: bytemuck::pod_collect_to_vec(props),
                 springs: bytemuck::pod_collect_to_vec(springs),
@@ -236,8 +251,10 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Simulation, CheckpointE
     if !d.is_done() || !cap.is_power_of_two() {
         return Err(corrupt(crate::files::DecodeError(bytes.len())));
     }
-    let mut sim = Simulation::from_parts(scene, p, springs, sources, rng, step, lost)
+    let sim = Simulation::from_parts(scene, p, springs, sources, rng, step, lost)
         .map_err(|e| CheckpointError::Scene(name, e))?;
-    sim.device_state = device_state;
-    Ok(sim)
+    Ok(Checkpoint {
+        sim,
+        device: device_state,
+    })
 }

@@ -488,7 +488,7 @@ fn cmd_reproduce(
         if finished {
             // Measured and drawn below like a fresh run.
         } else if let Err(e) = run::run(
-            &mut choose_engine(sim, backend, quiet)?,
+            &mut choose_engine(checkpoint::Checkpoint::fresh(sim), backend, quiet)?,
             &run::RunOptions {
                 out: dir.clone(),
                 quiet,
@@ -657,10 +657,11 @@ fn cmd_run(
     backend: Backend,
     quiet: bool,
 ) -> Result<(), Failure> {
-    let sim = match &resume {
+    let start = match &resume {
         Some(ckpt) => checkpoint::read(ckpt, &overrides).map_err(bad_input)?,
-        None => build_simulation(&path, &overrides)?,
+        None => checkpoint::Checkpoint::fresh(build_simulation(&path, &overrides)?),
     };
+    let sim = &start.sim;
     let out = out.unwrap_or_else(|| PathBuf::from("runs").join(&sim.scene.name));
     if !quiet {
         eprintln!(
@@ -672,7 +673,7 @@ fn cmd_run(
             out.display()
         );
     }
-    let mut engine = choose_engine(sim, backend, quiet)?;
+    let mut engine = choose_engine(start, backend, quiet)?;
     if !quiet {
         eprintln!("backend: {}", engine.name());
     }
@@ -742,14 +743,20 @@ fn measure_and_draw(
 /// The engine for `--backend`: `gpu` insists on a GPU adapter; `auto` takes a hardware
 /// GPU when there is one and otherwise the CPU path, saying why. A software adapter
 /// (lavapipe) counts as no GPU for `auto`: the CPU path is faster than it.
-fn choose_engine(sim: Simulation, backend: Backend, quiet: bool) -> Result<Engine, Failure> {
+/// A checkpoint's device state (from a GPU run) resumes the GPU path bitwise; the CPU
+/// path continues from the f64 state.
+fn choose_engine(
+    start: checkpoint::Checkpoint,
+    backend: Backend,
+    quiet: bool,
+) -> Result<Engine, Failure> {
     let run_failure = |e: &dyn std::fmt::Display| Failure {
         code: 1,
         message: e.to_string(),
     };
     match backend {
-        Backend::Cpu => Ok(Engine::cpu(sim)),
-        Backend::Gpu => GpuSimulation::new(sim)
+        Backend::Cpu => Ok(Engine::cpu(start.sim)),
+        Backend::Gpu => GpuSimulation::resume(start)
             .map(|g| Engine::Gpu(Box::new(g)))
             .map_err(|e| run_failure(&e)),
         Backend::Auto => {
@@ -760,7 +767,8 @@ fn choose_engine(sim: Simulation, backend: Backend, quiet: bool) -> Result<Engin
                     a.get_info().name
                 ),
                 Ok(_) => {
-                    return match GpuSimulation::new(sim.clone()) {
+                    let fallback = start.sim.clone();
+                    return match GpuSimulation::resume(start) {
                         Ok(g) => Ok(Engine::Gpu(Box::new(g))),
                         Err(e) => {
                             if !quiet {
@@ -768,7 +776,7 @@ fn choose_engine(sim: Simulation, backend: Backend, quiet: bool) -> Result<Engin
                                     "note: the GPU path is unavailable ({e}); using the CPU reference path"
                                 );
                             }
-                            Ok(Engine::cpu(sim))
+                            Ok(Engine::cpu(fallback))
                         }
                     };
                 }
@@ -777,7 +785,7 @@ fn choose_engine(sim: Simulation, backend: Backend, quiet: bool) -> Result<Engin
             if !quiet {
                 eprintln!("note: using the CPU reference path: {why}");
             }
-            Ok(Engine::cpu(sim))
+            Ok(Engine::cpu(start.sim))
         }
     }
 }

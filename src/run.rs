@@ -3,7 +3,7 @@
 //! written atomically; `summary.json` is written last and marks a complete run.
 
 use crate::files::write_atomic;
-use crate::gpu::GpuSimulation;
+use crate::gpu::{DeviceState, GpuSimulation};
 use crate::progress::Progress;
 use crate::sim::{Divergence, Simulation};
 use crate::{checkpoint, snapshot};
@@ -98,11 +98,17 @@ pub enum Engine {
 }
 
 impl Engine {
-    pub fn cpu(mut sim: Simulation) -> Self {
-        // A state loaded from a GPU checkpoint carries the device state; the CPU path
-        // continues from the f64 state instead and must not write the stale copy.
-        sim.device_state = None;
+    pub fn cpu(sim: Simulation) -> Self {
         Self::Cpu(Box::new(sim))
+    }
+
+    /// The host state and, on the GPU path, the exact device state: what a checkpoint
+    /// holds (reads the device back on the GPU path).
+    pub fn checkpoint_state(&mut self) -> (&Simulation, Option<&DeviceState>) {
+        match self {
+            Self::Cpu(s) => (s, None),
+            Self::Gpu(g) => g.checkpoint_state(),
+        }
     }
 
     pub fn name(&self) -> String {
@@ -275,7 +281,7 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
             }
         }
         if ckpt_every.is_some_and(|k| step.is_multiple_of(k)) {
-            write_checkpoint(engine.sim(), &ckpt_dir, &mut checkpoints)?;
+            write_checkpoint(engine, &ckpt_dir, &mut checkpoints)?;
             let log_path = out.join("log.csv");
             write_atomic(&log_path, log.as_bytes()).map_err(io(&log_path))?;
         }
@@ -305,14 +311,15 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
     progress.finish();
 
     let backend = engine.name();
-    let sim = engine.sim();
+    let last_step = engine.step();
     if checkpoints
         .last()
-        .is_none_or(|p| !p.ends_with(format!("ckpt_{:010}.bin", sim.step)))
+        .is_none_or(|p| !p.ends_with(format!("ckpt_{last_step:010}.bin")))
         && ckpt_every.is_some()
     {
-        write_checkpoint(sim, &ckpt_dir, &mut checkpoints)?;
+        write_checkpoint(engine, &ckpt_dir, &mut checkpoints)?;
     }
+    let sim = engine.sim();
     let log_path = out.join("log.csv");
     write_atomic(&log_path, log.as_bytes()).map_err(io(&log_path))?;
     let final_json = snapshot::write(sim, out, "final").map_err(io(out))?;
@@ -340,12 +347,13 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
 }
 
 fn write_checkpoint(
-    sim: &Simulation,
+    engine: &mut Engine,
     dir: &Path,
     written: &mut Vec<PathBuf>,
 ) -> Result<(), RunError> {
+    let (sim, device) = engine.checkpoint_state();
     let path = dir.join(format!("ckpt_{:010}.bin", sim.step));
-    checkpoint::write(sim, &path).map_err(io(&path))?;
+    checkpoint::write(sim, device, &path).map_err(io(&path))?;
     written.push(path);
     while written.len() > KEEP_CHECKPOINTS {
         let old = written.remove(0);

@@ -79,8 +79,6 @@ pub struct Simulation {
     pub step: u64,
     /// Particles removed for leaving the domain.
     pub lost: u64,
-    /// The exact device state when this state came from (or goes to) the GPU path.
-    pub device_state: Option<crate::gpu::DeviceState>,
     // Per-step buffers, rebuilt every step (not part of the state).
     /// The polygons' corners turned to their orientations at the current step.
     pub corners: RotatedCorners,
@@ -173,7 +171,6 @@ impl Simulation {
             rng,
             step,
             lost,
-            device_state: None,
             corners: RotatedCorners::default(),
             pairs: Vec::new(),
             contacts: Vec::new(),

@@ -99,7 +99,9 @@ fn resume_from_checkpoint_is_bitwise_identical() {
     run_to(&full, Simulation::new(small_heap(&[])).unwrap());
     // checkpoint at t = 15 (step 7500), with the heap still forming
     let ckpt = full.join("checkpoints/ckpt_0000007500.bin");
-    let sim = talus::checkpoint::read(&ckpt, &[]).expect("checkpoint loads");
+    let sim = talus::checkpoint::read(&ckpt, &[])
+        .expect("checkpoint loads")
+        .sim;
     assert_eq!(sim.step, 7500);
     assert!(
         !sim.springs.is_empty(),
@@ -145,7 +147,9 @@ fn polygon_runs_resume_bitwise() {
     let (full, resumed) = (tmp.join("full"), tmp.join("resumed"));
     run_to(&full, Simulation::new(polygon_scene()).unwrap());
     let ckpt = full.join("checkpoints/ckpt_0000005000.bin");
-    let sim = talus::checkpoint::read(&ckpt, &[]).expect("checkpoint loads");
+    let sim = talus::checkpoint::read(&ckpt, &[])
+        .expect("checkpoint loads")
+        .sim;
     assert!(
         sim.particles
             .shape

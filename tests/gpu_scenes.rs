@@ -377,14 +377,15 @@ fn assert_gpu_bitwise(name: &str, scene: fn() -> talus::scene::Scene, steps: u64
     let dir = std::env::temp_dir().join(format!("talus-gpu-resume-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("ckpt.bin");
-    talus::checkpoint::write(b.download(), &path).unwrap();
+    let (sim, device) = b.checkpoint_state();
+    talus::checkpoint::write(sim, device, &path).unwrap();
     let loaded = talus::checkpoint::read(&path, &[]).unwrap();
     assert!(
-        loaded.device_state.is_some(),
+        loaded.device.is_some(),
         "a GPU checkpoint carries the device state"
     );
     let gpu = common::gpu("resume").unwrap();
-    let mut b = GpuSimulation::with_gpu(loaded, gpu).unwrap();
+    let mut b = GpuSimulation::resume_with_gpu(loaded, gpu).unwrap();
     b.advance(steps - steps / 2).unwrap();
     let (sa, sb) = (a.device_state(), b.device_state());
     assert!(

@@ -41,6 +41,7 @@ use step::{dispatch_args, initial_control};
 pub use transfer::{build_table, corner_starts, from_device, table_lookup, to_device};
 use transfer::{device_corners, device_walls, initial_state, pr_local};
 
+use crate::checkpoint::Checkpoint;
 use crate::contacts::{Pair, WALL_BASE};
 use crate::create::{
     self,
@@ -101,6 +102,9 @@ pub struct GpuSimulation {
     dispatches: std::cell::Cell<u64>,
     indirect: std::cell::Cell<u64>,
     submissions: std::cell::Cell<u64>,
+    /// The exact device state read by the last `download`: what a checkpoint of `sim`
+    /// carries (`checkpoint_state`).
+    downloaded: Option<DeviceState>,
 }
 
 /// What a GPU checkpoint adds to the f64 state: the exact device state, so that a GPU
@@ -171,7 +175,22 @@ impl GpuSimulation {
         Self::with_gpu(sim, Gpu::open()?)
     }
 
-    pub fn with_gpu(mut sim: Simulation, gpu: Gpu) -> Result<Self, GpuError> {
+    /// Uploads the simulation's state to an opened adapter.
+    pub fn with_gpu(sim: Simulation, gpu: Gpu) -> Result<Self, GpuError> {
+        Self::resume_with_gpu(Checkpoint::fresh(sim), gpu)
+    }
+
+    /// Opens the best adapter and uploads a checkpoint: its exact device state when it
+    /// has one (a GPU run resumes bitwise), else its f64 state.
+    pub fn resume(ckpt: Checkpoint) -> Result<Self, GpuError> {
+        Self::resume_with_gpu(ckpt, Gpu::open()?)
+    }
+
+    pub fn resume_with_gpu(ckpt: Checkpoint, gpu: Gpu) -> Result<Self, GpuError> {
+        let Checkpoint {
+            sim,
+            device: device_state,
+        } = ckpt;
         let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);
         if !point_sources.is_empty() && !layered_specs.is_empty() {
             return Err(GpuError::Unsupported(
@@ -179,7 +198,6 @@ impl GpuSimulation {
                     .into(),
             ));
         }
-        let device_state = sim.device_state.take();
         // Cells hold every candidate within range + skin of the lists (issue 13): the
         // law's grid with its cells doubled (the fixed-point unit scales by a power of
         // two; any other size loses the lattice piles' exact alignment, see
@@ -294,6 +312,7 @@ impl GpuSimulation {
             dispatches: Default::default(),
             submissions: Default::default(),
             indirect: Default::default(),
+            downloaded: None,
         })
     }
 

@@ -303,9 +303,16 @@ impl GpuSimulation {
         let (pairs, contacts) = listed.into_iter().unzip();
         self.sim.pairs = pairs;
         self.sim.contacts = contacts;
-        self.sim.device_state = Some(ds);
+        self.downloaded = Some(ds);
         self.synced = true;
         &self.sim
+    }
+
+    /// The host mirror and the exact device state it was read from, for a checkpoint
+    /// (reads the device back first if it has run since).
+    pub fn checkpoint_state(&mut self) -> (&Simulation, Option<&DeviceState>) {
+        self.download();
+        (&self.sim, self.downloaded.as_ref())
     }
 
     /// The exact device state (for checkpoints).
