@@ -507,51 +507,13 @@ fn one_step_of_each_integrator_matches_the_cpu() {
     }
 }
 
-/// The text of function `name` in a WGSL file (from `fn name(` to its closing brace).
-fn wgsl_fn(text: &str, name: &str) -> String {
-    let start = text
-        .find(&format!("fn {name}("))
-        .unwrap_or_else(|| panic!("no fn {name}"));
-    let end = start + text[start..].find("\n}\n").unwrap() + 3;
-    text[start..end].to_string()
-}
-
 #[test]
 fn corner_rotation_matches_the_host_twin_bit_for_bit() {
     // orientation.wgsl rotates polygon corners with Q31 sin and cos in integers; its
     // host twin (src/gpu/orientation.rs, itself checked against f64 to 2e-9) must give
     // the very same integers on the device.
+    use common::wgsl::{COMMON, ORIENTATION, POSITION, run_wgsl_fn};
     use talus::gpu::orientation::{rotate_units, turn_sin_cos};
-    use wgpu::util::DeviceExt;
-    let Some(gpu) = common::gpu("corner_rotation_matches_the_host_twin") else {
-        return;
-    };
-    let position = include_str!("../shaders/position.wgsl");
-    let orientation = include_str!("../shaders/orientation.wgsl");
-    let mut source = String::from(
-        "const Q31_ONE: u32 = 0x80000000u;\nconst TWO_PI_Q29: u32 = 3373259426u;\n\
-         @group(0) @binding(0) var<storage, read_write> input: array<vec4<i32>>;\n\
-         @group(0) @binding(1) var<storage, read_write> out: array<vec4<i32>>;\n",
-    );
-    for f in ["mul_wide", "add64", "sub64"] {
-        source += &wgsl_fn(position, f);
-    }
-    for f in [
-        "mul_q31",
-        "turn_sin_cos",
-        "smul",
-        "round_q31",
-        "rotate_units",
-    ] {
-        source += &wgsl_fn(orientation, f);
-    }
-    source += "@compute @workgroup_size(64)\n\
-         fn main(@builtin(global_invocation_id) gid: vec3<u32>) {\n\
-             if (gid.x >= arrayLength(&input)) { return; }\n\
-             let x = input[gid.x];\n\
-             let sc = turn_sin_cos(bitcast<u32>(x.x));\n\
-             out[gid.x] = vec4<i32>(sc, rotate_units(x.yz, sc));\n\
-         }\n";
     let n = 8192usize;
     let mut rng = Rng::new(17);
     let input: Vec<[i32; 4]> = (0..n)
@@ -566,67 +528,22 @@ fn corner_rotation_matches_the_host_twin_bit_for_bit() {
             [turn as i32, c(&mut rng), c(&mut rng), 0]
         })
         .collect();
-    let dev = &gpu.device;
-    let module = dev.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("rotation"),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let pipeline = dev.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("rotation"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-    let bytes = (n * 16) as u64;
-    let input_buf = dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("input"),
-        contents: bytemuck::cast_slice(&input),
-        usage,
-    });
-    let output = dev.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("out"),
-        size: bytes,
-        usage,
-        mapped_at_creation: false,
-    });
-    let staging = dev.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("staging"),
-        size: bytes,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let group = dev.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input_buf.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: output.as_entire_binding(),
-            },
-        ],
-    });
-    let mut enc = dev.create_command_encoder(&Default::default());
-    {
-        let mut pass = enc.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &group, &[]);
-        pass.dispatch_workgroups((n as u32).div_ceil(64), 1, 1);
-    }
-    enc.copy_buffer_to_buffer(&output, 0, &staging, 0, bytes);
-    gpu.queue.submit([enc.finish()]);
-    staging
-        .slice(..)
-        .map_async(wgpu::MapMode::Read, |r| r.unwrap());
-    dev.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-    let view = staging.slice(..).get_mapped_range().expect("mapped");
-    let got: Vec<[i32; 4]> = bytemuck::cast_slice(&view).to_vec();
+    let words: Vec<[u32; 4]> = input.iter().map(|x| x.map(|v| v as u32)).collect();
+    let body = "
+    let x = bitcast<vec4<i32>>(wgsl_arg(k, 0u));
+    let sc = turn_sin_cos(bitcast<u32>(x.x));
+    wgsl_put(k, 0u, bitcast<vec4<u32>>(vec4<i32>(sc, rotate_units(x.yz, sc))));";
+    let Some(out) = run_wgsl_fn(
+        "corner_rotation_matches_the_host_twin",
+        &[COMMON, POSITION, ORIENTATION],
+        &talus::gpu::layout::Params::default(),
+        (1, 1),
+        body,
+        &words,
+    ) else {
+        return;
+    };
+    let got: Vec<[i32; 4]> = out.iter().map(|w| w.map(|v| v as i32)).collect();
     let mut differ = 0;
     for (x, g) in input.iter().zip(&got) {
         let sc = turn_sin_cos(x[0] as u32);

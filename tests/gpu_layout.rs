@@ -154,10 +154,9 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
 }
 
 #[test]
-fn host_and_wgsl_hash_agree_on_the_formula() {
-    // The WGSL hash_pair is the same expression: tests/gpu_kernels.rs builds spring
-    // tables with the Rust twin (`build_table`) and looks pairs up with the WGSL one
-    // (`gather_history`), which fails if they differ. Here: it is not symmetric, and it
+fn the_pair_hash_is_asymmetric_and_spreads_neighbours() {
+    // The WGSL hash_pair is this function bit for bit (tests/gpu_functions.rs
+    // `wgsl_pair_hash_is_its_rust_twin_bit_for_bit`). Here: it is not symmetric, and it
     // spreads neighbouring pairs over the table.
     assert_ne!(layout::hash_pair(1, 2), layout::hash_pair(2, 1));
     let mut seen = std::collections::HashSet::new();

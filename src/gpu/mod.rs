@@ -36,6 +36,7 @@ mod transfer;
 pub use buckets::{HASH_MIX_1, HASH_MIX_2, HASH_X, HASH_Z, MAX_BUCKETS, bucket, bucket_count};
 use buffers::{Buffers, Initial};
 use insert::{LayeredBase, SourceBase};
+pub use params::law_params;
 pub use step::{BATCHES_IN_FLIGHT, Counters, REBUILD_STAGES, STEPS_PER_SUBMIT, workgroups};
 use step::{dispatch_args, initial_control};
 pub use transfer::{build_table, corner_starts, from_device, table_lookup, to_device};

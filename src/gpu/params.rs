@@ -3,8 +3,8 @@
 
 use super::*;
 
-/// Law coefficients into Params.
-pub(super) fn law_params(law: &ContactLaw, p: &mut Params) {
+/// Law coefficients into Params (also for the tests that run laws.wgsl on its own).
+pub fn law_params(law: &ContactLaw, p: &mut Params) {
     match law {
         ContactLaw::SpringDashpot(l) => {
             p.law = LAW_SPRING_DASHPOT;

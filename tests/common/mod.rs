@@ -6,6 +6,7 @@ use talus::scene::{self, Scene};
 use talus::sim::Simulation;
 
 pub mod pairs;
+pub mod wgsl;
 
 /// A scene around `particles` and `contact`, with a large domain, no gravity by default.
 pub fn scene_value(contact: Value, particles: Value) -> Value {
