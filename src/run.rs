@@ -148,6 +148,17 @@ impl Engine {
         }
     }
 
+    /// Every particle's position in id order (on the GPU path the state alone is read
+    /// back: observers that follow particles step by step).
+    pub fn positions(&mut self) -> Vec<[f64; 2]> {
+        match self {
+            Self::Cpu(s) => (0..s.particles.len())
+                .map(|i| s.particles.position(i))
+                .collect(),
+            Self::Gpu(g) => g.positions(),
+        }
+    }
+
     /// The host copy without a readback: scene, law and grid are always current.
     pub fn host(&self) -> &Simulation {
         match self {

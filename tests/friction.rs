@@ -10,8 +10,9 @@ const MU: f64 = 0.4;
 /// A non-rotating disk (a sliding block) on a horizontal wall with gravity tilted by θ,
 /// plus a cloud of free disks falling far away so that the cell list's sorted order
 /// changes every step. Returns (displacement of the block along the wall, final spring
-/// force k_t|ξ| of its wall contact, the block's acceleration along the slope).
-fn block_on_incline(tan_theta: f64) -> (f64, f64, f64) {
+/// force k_t|ξ| of its wall contact, the block's acceleration along the slope); None on
+/// the GPU path without an adapter.
+fn block_on_incline(path: Path, tan_theta: f64) -> Option<(f64, f64, f64)> {
     let theta = tan_theta.atan();
     let g = 1.0;
     let mut others: Vec<serde_json::Value> = (0..12)
@@ -29,17 +30,18 @@ fn block_on_incline(tan_theta: f64) -> (f64, f64, f64) {
     v["walls"] = json!([{ "from": [-100.0, 0.0], "to": [100.0, 0.0] }]);
     v["gravity"] = json!({ "g": [g * theta.sin(), -g * theta.cos()] });
     v["dt"] = json!(2e-4);
-    let mut s = sim(&v);
+    let mut e = engine(path, "block_on_incline", sim(&v))?;
     // settle the normal contact and the spring
-    for _ in 0..20_000 {
-        s.step().unwrap();
-    }
-    let x0 = s.particles.position(6)[0];
-    let v0 = s.particles.velocity(6, s.dt())[0];
+    e.advance(20_000).unwrap();
+    let s = e.sim();
+    let (x0, v0, dt) = (
+        s.particles.position(6)[0],
+        s.particles.velocity(6, s.dt())[0],
+        s.dt(),
+    );
     let t = 2.0;
-    for _ in 0..(t / s.dt()) as usize {
-        s.step().unwrap();
-    }
+    e.advance((t / dt) as u64).unwrap();
+    let s = e.sim();
     let x1 = s.particles.position(6)[0];
     let v1 = s.particles.velocity(6, s.dt())[0];
     let k = s
@@ -47,37 +49,56 @@ fn block_on_incline(tan_theta: f64) -> (f64, f64, f64) {
         .iter()
         .position(|p| p.i == 6 && p.is_wall())
         .expect("block touches the wall");
-    (x1 - x0, s.contacts[k].f_t.abs(), (v1 - v0) / t)
+    Some((x1 - x0, s.contacts[k].f_t.abs(), (v1 - v0) / t))
 }
 
 #[test]
 fn block_sticks_below_tan_theta_equals_mu() {
     let tan_theta = 0.9 * MU;
-    let (dx, f_t, _) = block_on_incline(tan_theta);
-    assert!(dx.abs() < 1e-9, "a sticking block creeps by {dx}");
-    // Static balance along the slope: f_t = m g sin θ with m = 1.
-    let expected = tan_theta.atan().sin();
-    assert!(
-        (f_t / expected - 1.0).abs() < 1e-6,
-        "spring force {f_t} vs m g sin θ = {expected}"
-    );
+    for path in PATHS {
+        let Some((dx, f_t, _)) = block_on_incline(path, tan_theta) else {
+            continue;
+        };
+        // The GPU path's f32 spring (ξ ≈ 1.7·10⁻⁴, one ulp 1.5·10⁻¹¹) misses increments
+        // v_t dt below half an ulp: a creep slower than ~4·10⁻⁸ per unit time goes
+        // unresisted until it shows (issue 14 item 5: the f32 integrator's velocities).
+        let creep = if path == Path::Gpu { 1e-7 } else { 1e-9 };
+        assert!(
+            dx.abs() < creep,
+            "{path:?}: a sticking block creeps by {dx}"
+        );
+        // Static balance along the slope: f_t = m g sin θ with m = 1.
+        let expected = tan_theta.atan().sin();
+        assert!(
+            (f_t / expected - 1.0).abs() < 1e-6,
+            "{path:?}: spring force {f_t} vs m g sin θ = {expected}"
+        );
+    }
 }
 
 #[test]
 fn block_slides_above_tan_theta_equals_mu() {
     let tan_theta = 1.1 * MU;
     let theta = tan_theta.atan();
-    let (dx, f_t, a) = block_on_incline(tan_theta);
-    let expected = theta.sin() - MU * theta.cos();
-    assert!(dx > 0.01, "a sliding block moves, dx = {dx}");
-    assert!(
-        (a / expected - 1.0).abs() < 1e-3,
-        "acceleration {a} vs g (sin θ − μ cos θ) = {expected}"
-    );
-    assert!(
-        (f_t / (MU * theta.cos()) - 1.0).abs() < 1e-3,
-        "friction at the Coulomb cap"
-    );
+    for path in PATHS {
+        let Some((dx, f_t, a)) = block_on_incline(path, tan_theta) else {
+            continue;
+        };
+        let expected = theta.sin() - MU * theta.cos();
+        assert!(dx > 0.01, "{path:?}: a sliding block moves, dx = {dx}");
+        // The GPU path's f32 Gear velocities drift (6·10⁻⁵ relative in free fall, issue 14
+        // item 5), here 4·10⁻⁵ g: 1.1·10⁻³
+        // of this small net acceleration (0.037 g).
+        let tol = if path == Path::Gpu { 2e-3 } else { 1e-3 };
+        assert!(
+            (a / expected - 1.0).abs() < tol,
+            "{path:?}: acceleration {a} vs g (sin θ − μ cos θ) = {expected}"
+        );
+        assert!(
+            (f_t / (MU * theta.cos()) - 1.0).abs() < 1e-3,
+            "{path:?}: friction at the Coulomb cap"
+        );
+    }
 }
 
 /// A free (rolling) disk on the same incline rolls without slipping for μ > tan θ / 3:

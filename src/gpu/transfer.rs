@@ -315,6 +315,27 @@ impl GpuSimulation {
         (&self.sim, self.downloaded.as_ref())
     }
 
+    /// Every particle's position (x, z) in id order: a light readback (the state alone)
+    /// for observers that follow a few particles step by step.
+    pub fn positions(&self) -> Vec<[f64; 2]> {
+        let live = self.read_control()[control::LIVE] as usize;
+        let ids: Vec<u32> = self.read_buffer(&self.buffers.ids, 0, live);
+        let states: Vec<State> = by_id(&ids, self.read_buffer(&self.buffers.state, 0, live));
+        let cell = self.params.cell_size;
+        (states.iter())
+            .map(|s| {
+                [0, 1].map(|k| {
+                    let f = position::Fixed {
+                        anchor: s.anchor[k],
+                        frac: s.frac[k],
+                        rem: s.q[0][k],
+                    };
+                    self.origin[k] + position::join(f, cell)
+                })
+            })
+            .collect()
+    }
+
     /// The exact device state (for checkpoints).
     pub fn device_state(&self) -> DeviceState {
         let live = self.read_control()[control::LIVE] as usize;

@@ -45,42 +45,111 @@ pub fn crossing(t0: f64, f0: f64, t1: f64, f1: f64) -> f64 {
     t0 + (t1 - t0) * f0 / (f0 - f1)
 }
 
+/// The two paths a physics check runs on (issue 14 item 7: written once, run on both).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Path {
+    Cpu,
+    Gpu,
+}
+
+pub const PATHS: [Path; 2] = [Path::Cpu, Path::Gpu];
+
+/// The engine of `path` for a simulation; None for the GPU path without an adapter
+/// (skipped with a message, unless the GPU is required).
+pub fn engine(path: Path, test: &str, sim: Simulation) -> Option<talus::run::Engine> {
+    match path {
+        Path::Cpu => Some(talus::run::Engine::cpu(sim)),
+        Path::Gpu => {
+            let gpu = self::gpu(test)?;
+            let g = talus::gpu::GpuSimulation::with_gpu(sim, gpu).expect("uploads");
+            Some(talus::run::Engine::Gpu(Box::new(g)))
+        }
+    }
+}
+
 /// Head-on collision of two equal unit disks (m = 1, radius 0.5) approaching at relative
-/// speed `v0`; returns (contact duration from the overlap δ > 0, restitution).
+/// speed `v0` from a gap of 0.002; returns (contact duration from the overlap δ > 0,
+/// restitution).
 pub fn head_on(contact: Value, v0: f64, dt: f64, integrator: &str) -> (f64, f64) {
+    head_on_on(Path::Cpu, contact, v0, dt, integrator).expect("the CPU path runs")
+}
+
+/// `head_on` on either path (None: no GPU). Runs are deterministic, so the collision is
+/// run twice: first in chunks of `CHUNK` steps to find the chunks where the overlap δ
+/// turns positive and back, then again step by step through those two chunks only,
+/// where δ's crossings of 0 are interpolated (a readback per step on the GPU path is
+/// what costs).
+pub fn head_on_on(
+    path: Path,
+    contact: Value,
+    v0: f64,
+    dt: f64,
+    integrator: &str,
+) -> Option<(f64, f64)> {
+    const CHUNK: u64 = 16;
     let mut v = scene_value(
         contact,
         json!([{ "kind": "list", "material": "m", "particles": [
-            { "position": [-0.6, 0.0], "diameter": 1.0, "velocity": [0.5 * v0, 0.0] },
-            { "position": [0.6, 0.0], "diameter": 1.0, "velocity": [-0.5 * v0, 0.0] }
+            { "position": [-0.501, 0.0], "diameter": 1.0, "velocity": [0.5 * v0, 0.0] },
+            { "position": [0.501, 0.0], "diameter": 1.0, "velocity": [-0.5 * v0, 0.0] }
         ]}]),
     );
     v["dt"] = json!(dt);
     v["integrator"] = json!(integrator);
-    let mut s = sim(&v);
-    let (mut t_in, mut t_out) = (None, None);
-    let mut prev = (s.time(), 1.0 - distance(&s, 0, 1));
+    let overlap = |e: &mut talus::run::Engine| {
+        let p = e.positions();
+        let r = (p[0][0] - p[1][0]).hypot(p[0][1] - p[1][1]);
+        (e.step() as f64 * dt, 1.0 - r)
+    };
+    // The gap of 0.002 closes at v0: fly to just before it.
+    let start = (0.95 * 0.002 / v0 / dt) as u64;
+    let mut e = engine(path, "head_on", sim(&v))?;
+    e.advance(start).expect("no divergence");
+    assert!(overlap(&mut e).1 < 0.0, "still apart");
+    // Pass 1: the chunks in which δ turns positive and back to 0 or below.
+    let (mut chunk_in, mut chunk_out) = (None, None);
+    let mut prev = overlap(&mut e);
     for _ in 0..10_000_000 {
-        s.step().expect("no divergence");
-        let now = (s.time(), 1.0 - distance(&s, 0, 1));
-        if t_in.is_none() && prev.1 <= 0.0 && now.1 > 0.0 {
-            t_in = Some(crossing(prev.0, prev.1, now.0, now.1));
-        }
-        if t_in.is_some() && prev.1 > 0.0 && now.1 <= 0.0 {
-            t_out = Some(crossing(prev.0, prev.1, now.0, now.1));
-        }
-        prev = now;
-        // well separated again: measure the outgoing speed in free flight
-        if t_out.is_some() && now.1 < -0.05 {
+        let at = e.step();
+        e.advance(CHUNK).expect("no divergence");
+        let now = overlap(&mut e);
+        if chunk_in.is_none() && now.1 > 0.0 {
+            chunk_in = Some(at);
+        } else if chunk_in.is_some() && prev.1 > 0.0 && now.1 <= 0.0 {
+            chunk_out = Some(at);
             break;
         }
+        prev = now;
     }
+    let (chunk_in, chunk_out) = (chunk_in.expect("collided"), chunk_out.expect("separated"));
+    // Pass 2: step by step through those chunks.
+    let mut e = engine(path, "head_on", sim(&v))?;
+    let crossing_in = |e: &mut talus::run::Engine, from: u64, inwards: bool| {
+        e.advance(from - e.step()).expect("no divergence");
+        let mut prev = overlap(e);
+        for _ in 0..=CHUNK {
+            e.advance(1).expect("no divergence");
+            let now = overlap(e);
+            if (inwards && prev.1 <= 0.0 && now.1 > 0.0)
+                || (!inwards && prev.1 > 0.0 && now.1 <= 0.0)
+            {
+                return crossing(prev.0, prev.1, now.0, now.1);
+            }
+            prev = now;
+        }
+        panic!("δ crosses 0 within the chunk from step {from}");
+    };
+    e.advance(start).expect("no divergence");
+    let t_in = crossing_in(&mut e, chunk_in, true);
+    let t_out = crossing_in(&mut e, chunk_out, false);
+    // The outgoing speed in free flight, once Gear's higher derivatives have let go of
+    // the contact (a few steps).
+    e.advance(200).expect("no divergence");
+    assert!(overlap(&mut e).1 < 0.0, "apart");
+    let s = e.sim();
     let vel = |i| s.particles.velocity(i, s.dt())[0];
     let v_out = vel(1) - vel(0);
-    (
-        t_out.expect("separated") - t_in.expect("collided"),
-        v_out / v0,
-    )
+    Some((t_out - t_in, v_out / v0))
 }
 
 /// A GPU device for a test, or None (with a message) when there is no adapter, unless
