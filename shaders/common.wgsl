@@ -119,6 +119,9 @@ struct State {
     // and frac (src/neighbours.rs `moved`; the survey kernel).
     listed_anchor: u32,
     listed_frac: vec2<u32>,
+    // q1's whole units: position units along x and z, turn units of the rotation
+    // (position.wgsl `renormalize_q1`); q[1].xyz holds the rest.
+    q1_whole: vec4<i32>,
 };
 
 struct Props {

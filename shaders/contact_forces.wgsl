@@ -39,7 +39,7 @@ fn wall_circle_near(i: u32, w: u32) -> bool {
 }
 
 fn velocity(i: u32) -> vec3<f32> {
-    return state[i].q[1].xyz / params.dt;
+    return q1_total(state[i].q1_whole, state[i].q[1]) / params.dt;
 }
 
 @compute @workgroup_size(WG)

@@ -13,6 +13,7 @@ fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
     turn_by(s, (3.0 / 20.0) * delta.z);
     displace(s, (3.0 / 20.0) * delta.xy);
     (*s).q[1] += (251.0 / 360.0) * delta;
+    renormalize_q1(s);
     (*s).q[2] += delta;
     (*s).q[3] += (11.0 / 18.0) * delta;
     (*s).q[4] += (1.0 / 6.0) * delta;

@@ -54,6 +54,7 @@ fn insert_place() {
             st.q[0] = vec4<f32>(cand.rem, cand.turn_rem, 0.0);
             st.turn = cand.turn;
             st.q[1] = vec4<f32>(cand.velocity, 0.0, 0.0);
+            renormalize_q1(&st);
             if (params.integrator == 0u) {
                 // Gear starts with the gravitational acceleration in q2.
                 let h = 0.5 * params.dt * params.dt;

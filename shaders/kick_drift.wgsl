@@ -11,6 +11,8 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
         var s = state[i];
         let a = acceleration(i, g);
         s.q[1] += a * params.dt * params.dt;
+        renormalize_q1(&s);
+        move_by_whole_q1(&s);
         turn_by(&s, s.q[1].z);
         displace(&s, s.q[1].xy);
         renormalize(&s);

@@ -1,5 +1,5 @@
 // Stage: Gear predictor (src/integrate/gear.rs `predict`): a Taylor step of the six
-// scaled derivatives, q_k += sum_{l>k} C(l, k) q_l.
+// scaled derivatives, q_k += sum_{l>k} C(l, k) q_l; q1 in fixed point (position.wgsl).
 
 fn predict_one(s: ptr<function, State>) {
     let q1 = (*s).q[1];
@@ -7,10 +7,13 @@ fn predict_one(s: ptr<function, State>) {
     let q3 = (*s).q[3];
     let q4 = (*s).q[4];
     let q5 = (*s).q[5];
+    // The move q1 + q2 + ... + q5: q1's whole units exactly, the rest in f32.
     let step = q1 + q2 + q3 + q4 + q5;
+    move_by_whole_q1(s);
     turn_by(s, step.z);
     displace(s, step.xy);
     (*s).q[1] += 2.0 * q2 + 3.0 * q3 + 4.0 * q4 + 5.0 * q5;
+    renormalize_q1(s);
     (*s).q[2] += 3.0 * q3 + 6.0 * q4 + 10.0 * q5;
     (*s).q[3] += 4.0 * q4 + 10.0 * q5;
     (*s).q[4] += 5.0 * q5;

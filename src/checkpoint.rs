@@ -14,8 +14,9 @@ use std::path::Path;
 const MAGIC: &[u8; 8] = b"TALUSCK2";
 /// Checkpoints of talus before polygons (no shapes): named in the error.
 const OLD_MAGIC: &[u8; 8] = b"TALUSCK1";
-/// Version of the raw device arrays a GPU checkpoint carries (fixed-point positions).
-const DEVICE_LAYOUT: u8 = 3;
+/// Version of the raw device arrays a GPU checkpoint carries (fixed-point positions and,
+/// since 4, fixed-point q1).
+const DEVICE_LAYOUT: u8 = 4;
 
 #[derive(Debug, thiserror::Error)]
 pub enum CheckpointError {
@@ -75,8 +76,8 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
     springs.keys.iter().for_each(|&k| e.u64(k));
     springs.values.iter().for_each(|&v| e.f64(v));
     // From a GPU run: the exact device state, for a bitwise GPU resume. The flag is the
-    // device layout's version (1: f32 offsets before fixed point, 2: f32 orientations;
-    // neither is read any more).
+    // device layout's version (1: f32 offsets before fixed point, 2: f32 orientations,
+    // 3: f32 q1; none is read any more: such a checkpoint resumes from its f64 state).
     match device {
         Some(ds) => {
             e.u8(DEVICE_LAYOUT);

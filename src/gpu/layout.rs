@@ -117,6 +117,10 @@ pub struct State {
     /// and its frac (the survey kernel's displacement test).
     pub listed_anchor: u32,
     pub listed_frac: [u32; 2],
+    /// q1 = v dt in fixed point: whole position units (x, z) and turn units (rotation);
+    /// q[1] holds the rest, at most half a unit (issue 14 item 5; position.wgsl
+    /// `renormalize_q1`).
+    pub q1_whole: [i32; 4],
 }
 
 #[repr(C)]
@@ -266,7 +270,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
         fields!(
             State,
             "State",
-            [q, anchor, frac, turn, listed_anchor, listed_frac]
+            [q, anchor, frac, turn, listed_anchor, listed_frac, q1_whole]
         ),
         fields!(
             Props,

@@ -99,6 +99,7 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
             let v = p.q[k][i];
             s.q[k] = [v[0] as f32, v[1] as f32, v[2] as f32, 0.0];
         }
+        (s.q1_whole, s.q[1]) = split_q1(p.q[1][i], cell);
         states.push(s);
         let flags =
             ((p.active[i] as u32) * ACTIVE) | ((p.fixed[i] as u32) * FIXED) | (p.material[i] << 8);
@@ -114,6 +115,32 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
         });
     }
     (states, props)
+}
+
+/// q1 = v dt (length, length, radians) in the device's fixed point: whole position and
+/// turn units, and the rest in f32 (twin of position.wgsl `renormalize_q1`).
+pub fn split_q1(q1: [f64; 3], cell: f32) -> ([i32; 4], [f32; 4]) {
+    let u = [
+        position::unit(cell),
+        position::unit(cell),
+        orientation::TURN_UNIT,
+    ];
+    let whole = [0, 1, 2].map(|k| (q1[k] / u[k]).round());
+    let rest = [0, 1, 2].map(|k| (q1[k] - whole[k] * u[k]) as f32);
+    (
+        [whole[0] as i32, whole[1] as i32, whole[2] as i32, 0],
+        [rest[0], rest[1], rest[2], 0.0],
+    )
+}
+
+/// `split_q1` back: q1 in f64.
+pub fn join_q1(whole: [i32; 4], rest: [f32; 4], cell: f32) -> [f64; 3] {
+    let u = [
+        position::unit(cell),
+        position::unit(cell),
+        orientation::TURN_UNIT,
+    ];
+    [0, 1, 2].map(|k| whole[k] as f64 * u[k] + rest[k] as f64)
 }
 
 /// Device layout → host f64 particles.
@@ -140,6 +167,8 @@ pub fn from_device(
             let v = s.q[k];
             p.q[k].push([v[0] as f64, v[1] as f64, v[2] as f64]);
         }
+        let last = p.q[1].len() - 1;
+        p.q[1][last] = join_q1(s.q1_whole, s.q[1], cell);
         p.radius
             .push((pr.radius_units as f64 + pr.radius_rem as f64) * position::unit(cell));
         p.mass.push(pr.mass as f64);
