@@ -1,6 +1,8 @@
-// Stage 1 of the counting sort (src/cell_list.rs `cell_index`): the cell of each active
-// particle. The anchor *is* the cell, clamped into the grid. Also clears the per-step
-// counters of the later stages. Like every stage of the cell list, it runs only when
+// Stages 1 and 2 of the counting sort (src/cell_list.rs `cell_index`, `cell_histogram`):
+// the cell of each active particle, counted in its cell at once (integer atomics: the
+// counts do not depend on the order of the additions; one dispatch less per rebuild).
+// The anchor *is* the cell, clamped into the grid. `clear_cells` clears the counters
+// first. Like every stage of the cell list, it runs only when
 // the neighbour lists are rebuilt (issue 13).
 
 // A grid-stride loop: the dispatch stops at 65535 workgroups, the cells and particles
@@ -30,6 +32,8 @@ fn cell_index(@builtin(global_invocation_id) gid: vec3<u32>) {
         sorted[live() - 1u - atomicAdd(&control[C_INACTIVE], 1u)] = i;
         return;
     }
-    let c = cell_coords(state[i].anchor);
-    cell_of[i] = bucket(c);
+    let c = bucket(cell_coords(state[i].anchor));
+    cell_of[i] = c;
+    // The histogram (src/cell_list.rs `cell_histogram`).
+    atomicAdd(&cell_count[c], 1u);
 }

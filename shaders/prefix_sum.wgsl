@@ -78,8 +78,13 @@ fn scan_add1(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (b < params.scan_blocks1 && rebuilding()) { scan[b] += scan[params.scan_offset2 + b / SCAN_WG]; }
 }
 
+// Also clears each cell's count, read for the last time by scan_level0: `scatter` counts
+// again from 0 as its cursor (src/cell_list.rs `scatter`; one dispatch less per rebuild).
 @compute @workgroup_size(SCAN_WG)
 fn scan_add0(@builtin(global_invocation_id) gid: vec3<u32>) {
     let c = gid.x;
-    if (c < params.cells && rebuilding()) { cell_start[c] += scan[c / SCAN_WG]; }
+    if (c < params.cells && rebuilding()) {
+        cell_start[c] += scan[c / SCAN_WG];
+        atomicStore(&cell_count[c], 0u);
+    }
 }

@@ -1,14 +1,8 @@
 // Stage 4 (src/cell_list.rs `scatter`): particle ids into cell order. The slot within a
 // cell comes from an atomic counter, so the order *within* a cell varies from run to
 // run; nothing downstream depends on it, because find_contacts sorts each particle's
-// contacts by partner id. The counts are reset by scan_level0's reader, so they are
-// reused here as the per-cell cursor after being cleared.
-
-@compute @workgroup_size(WG)
-fn clear_cursor(@builtin(global_invocation_id) gid: vec3<u32>) {
-    let c = gid.x;
-    if (c < params.cells && rebuilding()) { atomicStore(&cell_count[c], 0u); }
-}
+// contacts by partner id. The counts, read for the last time by scan_level0 and cleared
+// by scan_add0, serve here as the per-cell cursor.
 
 @compute @workgroup_size(WG)
 fn scatter(@builtin(global_invocation_id) gid: vec3<u32>) {

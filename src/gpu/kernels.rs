@@ -63,15 +63,6 @@ pub const MODULES: &[ModuleSource] = &[
         ],
     },
     ModuleSource {
-        name: "cell_histogram",
-        parts: &[
-            COMMON,
-            POSITION,
-            ORIENTATION,
-            include_str!("../../shaders/cell_histogram.wgsl"),
-        ],
-    },
-    ModuleSource {
         name: "prefix_sum",
         parts: &[
             COMMON,
@@ -199,13 +190,11 @@ pub enum Kernel {
     PlanRebuild,
     ClearCells,
     CellIndex,
-    CellHistogram,
     ScanLevel0,
     ScanLevel1,
     ScanLevel2,
     ScanAdd1,
     ScanAdd0,
-    ClearCursor,
     Scatter,
     PermuteGather,
     PermuteStore,
@@ -226,7 +215,7 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 28] = [
+    pub const ALL: [Kernel; 26] = [
         Kernel::InsertCheck,
         Kernel::InsertPlace,
         Kernel::Predict,
@@ -234,13 +223,11 @@ impl Kernel {
         Kernel::PlanRebuild,
         Kernel::ClearCells,
         Kernel::CellIndex,
-        Kernel::CellHistogram,
         Kernel::ScanLevel0,
         Kernel::ScanLevel1,
         Kernel::ScanLevel2,
         Kernel::ScanAdd1,
         Kernel::ScanAdd0,
-        Kernel::ClearCursor,
         Kernel::Scatter,
         Kernel::PermuteGather,
         Kernel::PermuteStore,
@@ -267,13 +254,11 @@ impl Kernel {
             Kernel::PlanRebuild => ("plan", "plan_rebuild"),
             Kernel::ClearCells => ("cell_index", "clear_cells"),
             Kernel::CellIndex => ("cell_index", "cell_index"),
-            Kernel::CellHistogram => ("cell_histogram", "cell_histogram"),
             Kernel::ScanLevel0 => ("prefix_sum", "scan_level0"),
             Kernel::ScanLevel1 => ("prefix_sum", "scan_level1"),
             Kernel::ScanLevel2 => ("prefix_sum", "scan_level2"),
             Kernel::ScanAdd1 => ("prefix_sum", "scan_add1"),
             Kernel::ScanAdd0 => ("prefix_sum", "scan_add0"),
-            Kernel::ClearCursor => ("scatter", "clear_cursor"),
             Kernel::Scatter => ("scatter", "scatter"),
             Kernel::PermuteGather => ("permute", "permute_gather"),
             Kernel::PermuteStore => ("permute", "permute_store"),

@@ -23,7 +23,7 @@ pub(super) struct Batch {
 /// The stages of a rebuild of the neighbour lists, in order: the old lists' springs into
 /// the table, the cell list, the new memory order, the new lists and their springs. A
 /// step dispatches them indirectly (`plan_rebuild`, shaders/plan.wgsl).
-pub const REBUILD_STAGES: [Kernel; 16] = {
+pub const REBUILD_STAGES: [Kernel; 14] = {
     let c = GpuSimulation::CELL_LIST;
     [
         Kernel::ClearTable,
@@ -36,8 +36,6 @@ pub const REBUILD_STAGES: [Kernel; 16] = {
         c[5],
         c[6],
         c[7],
-        c[8],
-        c[9],
         Kernel::PermuteGather,
         Kernel::PermuteStore,
         Kernel::FindContacts,
@@ -68,7 +66,6 @@ pub fn workgroups(p: &Params, k: Kernel) -> u64 {
         Kernel::InsertPlace | Kernel::ScanLevel2 | Kernel::AdvanceClock | Kernel::PlanRebuild => 1,
         // Grid-stride loops: as many workgroups as one dispatch takes.
         Kernel::ClearCells => ceil_div(p.cells.max(p.n_cap) as u64, WG as u64).min(MAX_WORKGROUPS),
-        Kernel::ClearCursor => ceil_div(p.cells as u64, WG as u64),
         Kernel::ScanLevel0 | Kernel::ScanAdd0 => p.scan_blocks1 as u64,
         Kernel::ScanLevel1 | Kernel::ScanAdd1 => p.scan_blocks2 as u64,
         Kernel::ClearTable => ceil_div(p.table_mask as u64 + 1, WG as u64).min(MAX_WORKGROUPS),
@@ -170,16 +167,14 @@ impl GpuSimulation {
     }
 
     /// The kernels of the cell list, in order.
-    pub const CELL_LIST: [Kernel; 10] = [
+    pub const CELL_LIST: [Kernel; 8] = [
         Kernel::ClearCells,
         Kernel::CellIndex,
-        Kernel::CellHistogram,
         Kernel::ScanLevel0,
         Kernel::ScanLevel1,
         Kernel::ScanLevel2,
         Kernel::ScanAdd1,
         Kernel::ScanAdd0,
-        Kernel::ClearCursor,
         Kernel::Scatter,
     ];
 
