@@ -11,7 +11,10 @@
 fn clear_cells(@builtin(global_invocation_id) gid: vec3<u32>,
                @builtin(num_workgroups) groups: vec3<u32>) {
     if (!rebuilding()) { return; }
-    if (gid.x == 0u) { atomicStore(&control[C_INACTIVE], 0u); }
+    if (gid.x == 0u) {
+        atomicStore(&control[C_INACTIVE], 0u);
+        atomicStore(&pairs.count, 0u);
+    }
     let stride = groups.x * WG;
     for (var c = gid.x; c < max(params.cells, params.n_cap); c += stride) {
         if (c < params.cells) { atomicStore(&cell_count[c], 0u); }

@@ -6,6 +6,8 @@
 // precision; see position.wgsl, which every module includes after this file.
 
 const WG: u32 = 64u;
+// Workgroups of one dispatch in one dimension at most (src/gpu/mod.rs).
+const MAX_WORKGROUPS: u32 = 65535u;
 // Contacts per particle as the lower id (its own list) and as the higher id.
 const MAX_CONTACTS: u32 = 16u;
 const WALL_BASE: u32 = 0xFFFF0000u;
@@ -221,6 +223,14 @@ struct Candidate {
 // normal (n_x, n_z) from j to i and the contact point relative to i's centre (issue 19).
 @group(0) @binding(25) var<storage, read_write> contact_info: array<vec4<f32>>;
 @group(0) @binding(26) var<storage, read_write> contact_geo: array<vec4<f32>>;
+// Every candidate of the lists as one compact list of `count` slots (i MAX_CONTACTS +
+// k), written by find_contacts at a rebuild, for contact_forces under the overlap-area
+// law, which takes one thread per pair (issue 14 item 5). clear_cells empties it.
+struct PairList {
+    count: atomic<u32>,
+    slot: array<u32>,
+};
+@group(0) @binding(27) var<storage, read_write> pairs: PairList;
 // The spring table keyed by pair: touched only at a rebuild of the lists, which stores
 // the old lists' springs into it and gathers the new lists' from it (issue 13).
 @group(1) @binding(0) var<storage, read_write> table: array<Entry>;

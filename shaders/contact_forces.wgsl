@@ -42,95 +42,115 @@ fn velocity(i: u32) -> vec3<f32> {
     return q1_total(state[i].q1_whole, state[i].q[1]) / params.dt;
 }
 
+// Disks: a thread per particle, over its own list (its state read once for all its
+// candidates). The overlap-area law: a thread per pair of the compact list find_contacts
+// wrote (`pairs`), dispatched with the workgroups `plan_pairs` wrote (striding over any
+// beyond them): a polygon pair costs far more than a disk pair, and a thread per
+// particle would run a third as many threads, each keeping the others of its group
+// waiting for its longest list.
 @compute @workgroup_size(WG)
-fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>) {
+fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>,
+                  @builtin(num_workgroups) groups: vec3<u32>) {
+    if (halted()) { return; }
+    if (POLYGONS) {
+        let total = atomicLoad(&pairs.count);
+        for (var t = gid.x; t < total; t += groups.x * WG) {
+            let slot = pairs.slot[t];
+            candidate_force(slot / MAX_CONTACTS, slot);
+        }
+        return;
+    }
     let i = gid.x;
-    if (i >= live() || halted()) { return; }
+    if (i >= live()) { return; }
+    for (var k = 0u; k < contact_count[i]; k++) {
+        candidate_force(i, i * MAX_CONTACTS + k);
+    }
+}
+
+// Candidate `slot` of particle i's list.
+fn candidate_force(i: u32, slot: u32) {
     let ri = props[i].radius;
     let m1 = props[i].mass;
     let v1 = velocity(i);
-    for (var k = 0u; k < contact_count[i]; k++) {
-        let slot = i * MAX_CONTACTS + k;
-        let j = contact_j[slot];
-        let wall = j >= WALL_BASE;
-        var g: Geometry;
-        var v2 = vec3<f32>(0.0);
-        var d_ij = vec2<f32>(0.0);   // centre i minus centre j
-        var rmin = ri;
-        var m12 = m1;
-        var mass = m1;
-        var o: Offset;
-        if (!wall) {
-            o = offset_ij(i, j);
-            d_ij = offset_vector(o);
-            v2 = velocity(j);
-            rmin = min(ri, props[j].radius);
-            let m2 = props[j].mass;
-            m12 = m1 * m2 / (m1 + m2);
-            mass = 2.0 * m12;
-        }
-        // The law sees the rate of delta: the overlap's for disks, L v_n / l for the
-        // overlap area (delta = A/l; src/forces.rs `area_contact_input`).
-        var rate = 1.0;
-        var touches = false;
-        if (POLYGONS) {
-            var a: AreaContact;
-            if (wall) {
-                touches = wall_circle_near(i, j - WALL_BASE);
-                if (touches) { a = area_contact_wall(i, j - WALL_BASE, false); }
-            } else {
-                touches = circles_near(i, j);
-                if (touches) { a = area_contact(i, j, false); }
-            }
-            touches = touches && a.found;
-            var delta = 0.0;
-            var depth = 0.0;
-            rate = 0.0;
-            if (a.found && a.l > 0.0) {
-                delta = a.area / a.l;
-                if (a.chord > 0.0) { depth = a.area / a.chord; }
-                rate = a.chord / a.l;
-            }
-            g = Geometry(a.n, delta, depth, 0.0, a.point, true);
-        } else if (wall) {
-            g = disk_wall(i, j - WALL_BASE);
-            touches = g.r < params.range_factor * g.sigma;
+    let j = contact_j[slot];
+    let wall = j >= WALL_BASE;
+    var g: Geometry;
+    var v2 = vec3<f32>(0.0);
+    var d_ij = vec2<f32>(0.0);   // centre i minus centre j
+    var rmin = ri;
+    var m12 = m1;
+    var mass = m1;
+    var o: Offset;
+    if (!wall) {
+        o = offset_ij(i, j);
+        d_ij = offset_vector(o);
+        v2 = velocity(j);
+        rmin = min(ri, props[j].radius);
+        let m2 = props[j].mass;
+        m12 = m1 * m2 / (m1 + m2);
+        mass = 2.0 * m12;
+    }
+    // The law sees the rate of delta: the overlap's for disks, L v_n / l for the
+    // overlap area (delta = A/l; src/forces.rs `area_contact_input`).
+    var rate = 1.0;
+    var touches = false;
+    if (POLYGONS) {
+        var a: AreaContact;
+        if (WALLS && wall) {
+            touches = wall_circle_near(i, j - WALL_BASE);
+            if (touches) { a = area_contact_wall(i, j - WALL_BASE); }
         } else {
-            g = disk_disk_at(o, i, j);
-            touches = disks_touch(o, i, j, g);
+            touches = circles_near(i, j);
+            if (touches) { a = area_contact(i, j); }
         }
-        if (!touches) {
-            contact_ft[slot] = vec4<f32>(0.0);
-            hist_in[slot] = 0.0;
-            touching[slot] = 0u;
-            continue;
+        touches = touches && a.found;
+        var delta = 0.0;
+        var depth = 0.0;
+        rate = 0.0;
+        if (a.found && a.l > 0.0) {
+            delta = a.area / a.l;
+            if (a.chord > 0.0) { depth = a.area / a.chord; }
+            rate = a.chord / a.l;
         }
-        touching[slot] = 1u;
-        let l1 = g.arm;
-        let l2 = d_ij + l1;
-        let s1 = v1.z * vec2<f32>(-l1.y, l1.x);
-        var s2 = vec2<f32>(0.0);
-        if (!wall) { s2 = v2.z * vec2<f32>(-l2.y, l2.x); }
-        // Relative velocity of the two surfaces at the contact point.
-        let v12 = v1.xy + s1 - v2.xy - s2;
-        let t = tangent(g.n);
-        let input = ContactInput(g.delta, g.r, g.sigma, -dot(v12, g.n) * rate, dot(v12, t),
-                                 m12, mass, hist_in[slot], params.dt);
-        let res = evaluate(input);
-        let f = res.f_n * g.n + res.f_t * t;
-        contact_ft[slot] = vec4<f32>(f, cross2(l1, f), -cross2(l2, f));
-        // In place: the slot's spring is the list's history from step to step.
-        hist_in[slot] = res.history;
-        let finite = abs(f.x) <= 3.0e38 && abs(f.y) <= 3.0e38;
-        let too_deep = g.delta / rmin > params.max_overlap;
-        if (!finite) { halt(HALT_NOT_FINITE, i); }
-        if (too_deep) { halt(HALT_OVERLAP, i); }
-        // A diverging contact is recorded whatever the step: the halt report names the
-        // deepest overlap of the particle (`GpuSimulation::halt_cause`), and older
-        // records of its slots are all within the limit, or their step would have halted.
-        if (RECORD || !finite || too_deep) {
-            contact_info[slot] = vec4<f32>(res.f_n, res.f_t, g.delta, res.energy);
-            contact_geo[slot] = vec4<f32>(g.n, l1);
-        }
+        g = Geometry(a.n, delta, depth, 0.0, a.point, true);
+    } else if (WALLS && wall) {
+        g = disk_wall(i, j - WALL_BASE);
+        touches = g.r < params.range_factor * g.sigma;
+    } else {
+        g = disk_disk_at(o, i, j);
+        touches = disks_touch(o, i, j, g);
+    }
+    if (!touches) {
+        contact_ft[slot] = vec4<f32>(0.0);
+        hist_in[slot] = 0.0;
+        touching[slot] = 0u;
+        return;
+    }
+    touching[slot] = 1u;
+    let l1 = g.arm;
+    let l2 = d_ij + l1;
+    let s1 = v1.z * vec2<f32>(-l1.y, l1.x);
+    var s2 = vec2<f32>(0.0);
+    if (!wall) { s2 = v2.z * vec2<f32>(-l2.y, l2.x); }
+    // Relative velocity of the two surfaces at the contact point.
+    let v12 = v1.xy + s1 - v2.xy - s2;
+    let t = tangent(g.n);
+    let input = ContactInput(g.delta, g.r, g.sigma, -dot(v12, g.n) * rate, dot(v12, t),
+                             m12, mass, hist_in[slot], params.dt);
+    let res = evaluate(input);
+    let f = res.f_n * g.n + res.f_t * t;
+    contact_ft[slot] = vec4<f32>(f, cross2(l1, f), -cross2(l2, f));
+    // In place: the slot's spring is the list's history from step to step.
+    hist_in[slot] = res.history;
+    let finite = abs(f.x) <= 3.0e38 && abs(f.y) <= 3.0e38;
+    let too_deep = g.delta / rmin > params.max_overlap;
+    if (!finite) { halt(HALT_NOT_FINITE, i); }
+    if (too_deep) { halt(HALT_OVERLAP, i); }
+    // A diverging contact is recorded whatever the step: the halt report names the
+    // deepest overlap of the particle (`GpuSimulation::halt_cause`), and older
+    // records of its slots are all within the limit, or their step would have halted.
+    if (RECORD || !finite || too_deep) {
+        contact_info[slot] = vec4<f32>(res.f_n, res.f_t, g.delta, res.energy);
+        contact_geo[slot] = vec4<f32>(g.n, l1);
     }
 }

@@ -25,3 +25,22 @@ fn plan_rebuild(@builtin(local_invocation_index) l: u32) {
         dispatch_args[now + 2u] = 1u;
     }
 }
+
+// Stage: the workgroups of contact_forces under the overlap-area law, which takes a
+// thread per pair (issue 14 item 5): at a rebuild, from the pairs find_contacts listed
+// (`pairs`), PAIRS_PER_THREAD to a thread; the same until the next rebuild. At most
+// MAX_WORKGROUPS: contact_forces strides over the rest. Its arguments follow the
+// rebuild stages' two sets in dispatch_args (`PAIR_ARGS_OFFSET` in src/gpu/step.rs).
+// A hardware adapter takes one pair per thread, for as many threads as it can run; a
+// software one (lavapipe) runs every thread of a group through every branch, and takes
+// four, so that a group's threads share out the pairs evenly (src/gpu/kernels.rs).
+override PAIRS_PER_THREAD: u32 = 1u;
+
+@compute @workgroup_size(1)
+fn plan_pairs() {
+    if (!rebuilding()) { return; }
+    let at = 8u * (arrayLength(&dispatch_args) / 8u);
+    let per_group = WG * PAIRS_PER_THREAD;
+    let groups = (atomicLoad(&pairs.count) + per_group - 1u) / per_group;
+    dispatch_args[at] = min(groups, MAX_WORKGROUPS);
+}

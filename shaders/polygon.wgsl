@@ -1,23 +1,23 @@
-// Overlap-area geometry of convex polygons (src/overlap.rs, SPEC 2.3), step for step:
-// p clipped by the edges of q near the contact (Sutherland-Hodgman), remembering for
-// each corner of the overlap the line its outgoing edge lies on (an edge of p or of q).
-// A corner between two lines of p is a corner of p, between two of q one of q, between
-// one of each a crossing of the outlines: the three origins src/overlap.rs tags. The
+// Overlap-area geometry of convex polygons (src/overlap.rs, SPEC 2.3). Two polygons:
+// each one's edges cut to the part inside the other (`edges_inside`), whose ends are
+// corners or crossings of the outlines (`polygon_polygon`); a polygon and a wall: p
+// clipped by the wall's line and the lines across its ends (Sutherland-Hodgman,
+// remembering for each corner of the overlap the line its outgoing edge lies on). The
 // line through the two crossings farthest apart gives the normal, its midpoint the
 // force point.
 //
 // Precision (SPEC 3; README "Precision"). Corners are whole position units in a frame
 // at particle j's centre (exact: the fixed-point offset and corners rotated in integers,
-// orientation.wgsl) plus small f32 remainders. The clipping runs in f32, in units, in a
+// orientation.wgsl) plus small f32 remainders. The cutting runs in f32, in units, in a
 // frame centred between the pair: it finds the lines that bound the overlap, the
 // crossings, the force point and the normal to ~3e-8 d, plenty for them. Not for the
 // area: a resting contact is a sliver ~1e-5 d thin, and f32 corners half a diameter out
-// carry 3e-8 d. So `exact_area` computes it again from the lines, in a frame along the
+// carry 3e-8 d. So the area is computed again from the lines, in a frame along the
 // contact line: each overlap corner's distance w from that line comes from exact 64-bit
 // integer dot and cross products (a corner of p or q directly; a crossing by
 // interpolating along whichever of its two edges is flatter, from the nearer end), and
-// A = 1/2 sum (w_k + w_k+1)(u_k - u_k+1) needs the coordinates u along the line only to
-// f32. A/l is then right to ~1e-9 d however thin the overlap.
+// A = 1/2 sum (w_s + w_e)(u_s - u_e) over the boundary's pieces needs the coordinates u
+// along the line only to f32. A/l is then right to ~1e-9 d however thin the overlap.
 
 const MAX_CLIP: u32 = 36u;
 
@@ -25,9 +25,11 @@ const MAX_CLIP: u32 = 36u;
 // scenes compile without the polygon branches, whose large per-thread arrays would
 // otherwise cost every disk contact registers and memory.
 override POLYGONS: bool = false;
-const ORIGIN_P: u32 = 0u;
-const ORIGIN_Q: u32 = 1u;
-const ORIGIN_CROSSING: u32 = 2u;
+// Which shapes the scene has, now or from its sources (src/gpu/kernels.rs `Shapes`), and
+// whether it has walls: the pipelines leave out the contact branches of the others.
+override POLYGON_SHAPES: bool = true;
+override DISK_SHAPES: bool = true;
+override WALLS: bool = true;
 // Line ids: edge m of p (corner m to m + 1) is m, edge m of q is Q_LINE + m; then a
 // wall's line and the lines across its two ends.
 const Q_LINE: u32 = 16u;
@@ -48,34 +50,51 @@ fn no_contact() -> AreaContact {
     return AreaContact(0.0, vec2<f32>(0.0, 1.0), vec2<f32>(0.0), 0.0, 0.0, false);
 }
 
-// A polygon in a contact frame: corners in whole units `w`, an f32 remainder `e`
-// shared by all, and the orientation remainder `spin` (turn units) about the centre
-// `base`, whose first-order turn of each corner is added in f32.
+// A polygon in a contact frame, read where it lies: corner m is `base` plus its rotated
+// corner `corners[first + m].zw` in whole units, plus an f32 remainder `e` shared by
+// all and the first-order turn of the orientation remainder `spin` (turn units) about
+// the centre `base`. No copy of the corners: a per-thread array of them is local
+// memory on a GPU, and on a software adapter every thread's copy is zeroed and written
+// lane by lane (issue 14 item 5).
+// `reach`: the circumscribed radius (units).
 struct Outline {
-    w: array<vec2<i32>, 16>,
+    first: u32,
     n: u32,
     base: vec2<i32>,
     e: vec2<f32>,
     spin: f32,
+    reach: f32,
 };
 
-fn load_outline(k: u32, base: vec2<i32>, e: vec2<f32>, o: ptr<function, Outline>) {
+fn load_outline(k: u32, base: vec2<i32>, e: vec2<f32>) -> Outline {
     let sh = props[k].shape;
-    for (var m = 0u; m < sh.y; m++) { (*o).w[m] = base + corners[sh.x + m].zw; }
-    (*o).n = sh.y;
-    (*o).base = base;
-    (*o).e = e;
-    (*o).spin = state[k].q[0].z;
+    let reach = f32(props[k].radius_units) + props[k].radius_rem;
+    return Outline(sh.x, sh.y, base, e, state[k].q[0].z, reach);
+}
+
+// The centre in f32 units relative to the point h of the frame.
+fn centre_at(o: ptr<function, Outline>, h: vec2<i32>) -> vec2<f32> {
+    return vec2<f32>((*o).base - h) + (*o).e;
+}
+
+// Corner m in whole units.
+fn ow(o: ptr<function, Outline>, m: u32) -> vec2<i32> {
+    return (*o).base + corners[(*o).first + m].zw;
+}
+
+// The corner after m.
+fn next_corner(o: ptr<function, Outline>, m: u32) -> u32 {
+    return select(m + 1u, 0u, m + 1u >= (*o).n);
 }
 
 // The remainder of corner m (units).
 fn corner_e(o: ptr<function, Outline>, m: u32) -> vec2<f32> {
-    return (*o).e + corner_spin((*o).w[m] - (*o).base, (*o).spin);
+    return (*o).e + corner_spin(ow(o, m) - (*o).base, (*o).spin);
 }
 
 // Corner m in f32 units relative to the point h of the frame.
 fn corner_at(o: ptr<function, Outline>, m: u32, h: vec2<i32>) -> vec2<f32> {
-    return vec2<f32>((*o).w[m] - h) + corner_e(o, m);
+    return vec2<f32>(ow(o, m) - h) + corner_e(o, m);
 }
 
 // The polygon being clipped: corners and the line of each corner's outgoing edge, in
@@ -110,18 +129,6 @@ fn corner_mean(c: ptr<function, Clip>, b: u32, n: u32) -> vec2<f32> {
     return s / f32(n);
 }
 
-// A circle holding every corner of polygon b of c: their mean (xy) and the largest
-// squared distance from it (z) (overlap.rs `bounding_circle`).
-fn bounding_circle(c: ptr<function, Clip>, b: u32, n: u32) -> vec3<f32> {
-    let m = corner_mean(c, b, n);
-    var r2 = 0.0;
-    for (var k = 0u; k < n; k++) {
-        let x = (*c).v[b][k] - m;
-        r2 = max(r2, dot(x, x));
-    }
-    return vec3<f32>(m, r2);
-}
-
 fn reduced_arm(li: f32, lj: f32, scale: f32) -> f32 {
     let floor = 1.0e-6 * scale;
     let a = max(li, floor);
@@ -154,17 +161,9 @@ fn clip_lines(c: ptr<function, Clip>, src: u32, n: u32, a: vec2<f32>, m: vec2<f3
     return out;
 }
 
-fn origin_of(line_in: u32, line_out: u32) -> u32 {
-    let pin = line_in < Q_LINE;
-    let pout = line_out < Q_LINE;
-    if (pin && pout) { return ORIGIN_P; }
-    if (!pin && !pout) { return ORIGIN_Q; }
-    return ORIGIN_CROSSING;
-}
-
 // --- exact distances from the contact line ---
 
-// The frame of `exact_area`: the point o (whole units; `at` in clip coordinates) on
+// The frame of the exact area: the point o (whole units; `at` in clip coordinates) on
 // the contact line, its unit normal n in f32 and in Q30 integers, and the direction t
 // along the line; (t, n) is right-handed. Clip coordinates are relative to h.
 struct Frame {
@@ -185,13 +184,13 @@ fn make_frame(h: vec2<i32>, s: vec2<f32>, n: vec2<f32>) -> Frame {
 // corner from the frame point o, rounded once in f32, so a corner near the contact
 // keeps f32's relative precision of its small distance from it (issue 19).
 fn corner_uw(o: ptr<function, Outline>, m: u32, fr: Frame) -> vec2<f32> {
-    let x = vec2<f32>((*o).w[m] - fr.o) + corner_e(o, m);
+    let x = vec2<f32>(ow(o, m) - fr.o) + corner_e(o, m);
     return vec2<f32>(dot(x, fr.t), corner_w(o, m, fr));
 }
 
 // (x - o).n of corner m, from an exact 64-bit dot product.
 fn corner_w(o: ptr<function, Outline>, m: u32, fr: Frame) -> f32 {
-    let d = (*o).w[m] - fr.o;
+    let d = ow(o, m) - fr.o;
     let exact = add64(smul(d.x, fr.nq.x), smul(d.y, fr.nq.y));
     return i64_to_f32(exact) / Q30 + dot(corner_e(o, m), fr.n);
 }
@@ -233,10 +232,10 @@ fn crossing_uw(p: ptr<function, Outline>, mp: u32, q: ptr<function, Outline>, mq
     let y = (mp + 1u) % (*p).n;
     let a = mq;
     let b = (mq + 1u) % (*q).n;
-    let xw = (*p).w[x];
-    let yw = (*p).w[y];
-    let aw = (*q).w[a];
-    let bw = (*q).w[b];
+    let xw = ow(p, x);
+    let yw = ow(p, y);
+    let aw = ow(q, a);
+    let bw = ow(q, b);
     let xe = corner_e(p, x);
     let ye = corner_e(p, y);
     let ae = corner_e(q, a);
@@ -253,145 +252,314 @@ fn crossing_uw(p: ptr<function, Outline>, mp: u32, q: ptr<function, Outline>, mq
     return vec2<f32>(interpolate_w(qa.x, qb.x, r).x, on_q.x);
 }
 
-// (u, w) of overlap corner k, between lines lin and lout (x: its f32 clip position).
-fn vertex_uw(p: ptr<function, Outline>, q: ptr<function, Outline>, c: ptr<function, Clip>,
-             b: u32, n: u32, k: u32, fr: Frame) -> vec2<f32> {
-    let lin = (*c).line[b][(k + n - 1u) % n];
-    let lout = (*c).line[b][k];
-    let pin = lin < Q_LINE;
-    let pout = lout < Q_LINE;
-    if (pin && pout && lout == (lin + 1u) % (*p).n) { return corner_uw(p, lout, fr); }
-    if (!pin && !pout && lout - Q_LINE == (lin - Q_LINE + 1u) % (*q).n) {
-        return corner_uw(q, lout - Q_LINE, fr);
-    }
-    if (pin && !pout) { return crossing_uw(p, lin, q, lout - Q_LINE, fr); }
-    if (!pin && pout) { return crossing_uw(p, lout, q, lin - Q_LINE, fr); }
-    // Two lines of one polygon that are not neighbours: a degenerate clip, in f32.
-    let x = (*c).v[b][k] - fr.at;
-    return vec2<f32>(dot(x, fr.t), dot(x, fr.n));
+// --- polygon against polygon: the overlap from the edges, with no clipped copy ---
+//
+// The overlap of two convex polygons is bounded by the parts of p's edges inside q and
+// the parts of q's edges inside p. Each edge is cut to the interval of it inside every
+// half-plane of the other polygon (`edges_inside`); the interval's ends are a corner or
+// a crossing of the outlines, known by the two edges that cross. Everything the
+// contact needs comes from these intervals with no list of the overlap's corners: the
+// crossings (an interval of p that starts or ends inside an edge), the corners of each
+// polygon inside the other, and the area, A = 1/2 sum over the intervals of
+// (w_s + w_e)(u_s - u_e) in the frame of the contact line (the trapezoid rule needs
+// each boundary piece's ends, not their order). The quantities are those of
+// src/overlap.rs `polygon_polygon` (its Sutherland-Hodgman clip lists the same corners,
+// crossings and area), so the twin is that function, not its steps: a per-thread list
+// of clipped corners is local memory on a GPU and zeroed and written lane by lane on a
+// software one, while these loops keep everything in registers (issue 14 item 5).
+
+// Polygon a's edges inside polygon b. Bit e of `pieces`: part of edge e (corner e to
+// the next) lies in b; of `cross`, bit 2e: that part starts at a crossing with b's edge
+// nibble e of `entry` (else at corner e), bit 2e + 1: it ends at a crossing with b's
+// edge nibble e of `exit` (else at corner e + 1). Bit e of `corners`: corner e lies in
+// b; `sum` adds those corners up, `cross_sum` the crossings (f32 clip coordinates).
+struct Inside {
+    pieces: u32,
+    cross: u32,
+    entry: vec2<u32>,
+    exit: vec2<u32>,
+    corners: u32,
+    sum: vec2<f32>,
+    cross_sum: vec2<f32>,
+    area2: f32,   // sum of s x e over the parts (twice their share of the f32 area)
+};
+
+fn put_nibble(v: vec2<u32>, e: u32, x: u32) -> vec2<u32> {
+    let bits = x << (4u * (e & 7u));
+    if (e < 8u) { return vec2<u32>(v.x | bits, v.y); }
+    return vec2<u32>(v.x, v.y | bits);
 }
 
-// The overlap's area (units^2) from its lines: 1/2 sum (w_k + w_k+1)(u_k - u_k+1).
-fn exact_area(p: ptr<function, Outline>, q: ptr<function, Outline>, c: ptr<function, Clip>,
-              b: u32, n: u32, fr: Frame) -> f32 {
-    let first = vertex_uw(p, q, c, b, n, 0u, fr);
-    var prev = first;
-    var a = 0.0;
-    for (var k = 1u; k <= n; k++) {
-        var x = first;
-        if (k < n) { x = vertex_uw(p, q, c, b, n, k, fr); }
-        a += (prev.y + x.y) * (prev.x - x.x);
-        prev = x;
-    }
-    return 0.5 * a;
+fn nibble(v: vec2<u32>, e: u32) -> u32 {
+    return (select(v.y, v.x, e < 8u) >> (4u * (e & 7u))) & 15u;
 }
 
-// --- polygon against polygon, polygon against wall ---
+// Where the edge x-y crosses the line of b's edge f (x + s (y - x), the clip's f32
+// parameter: as `clip_lines` cuts an edge).
+fn edge_cut(x: vec2<f32>, y: vec2<f32>, b: ptr<function, Outline>, f: u32, h: vec2<i32>) -> f32 {
+    let ba = corner_at(b, f, h);
+    let bb = corner_at(b, next_corner(b, f), h);
+    let m = vec2<f32>(-(bb.y - ba.y), bb.x - ba.x);
+    let dx = dot(x - ba, m);
+    let dy = dot(y - ba, m);
+    return dx / (dx - dy);
+}
+
+fn edges_inside(a: ptr<function, Outline>, b: ptr<function, Outline>, h: vec2<i32>) -> Inside {
+    var r = Inside(0u, 0u, vec2<u32>(0u), vec2<u32>(0u), 0u, vec2<f32>(0.0), vec2<f32>(0.0), 0.0);
+    let na = (*a).n;
+    let nb = (*b).n;
+    // Only the edges of a within b's circle can reach into b, and they are found by
+    // b's half-planes whose lines pass near them: the others hold them all (or none,
+    // and then nothing overlaps). So a few edges are cut by a few half-planes, and
+    // the loops below run over those alone (bit masks), not over all pairs of edges.
+    // (Sutherland-Hodgman in src/overlap.rs skips the same half-planes, `clip_by`.)
+    let cb = centre_at(b, h);
+    let rb = (*b).reach * (1.0 + 1.0e-5);
+    var edges = 0u;
+    var mean = vec2<f32>(0.0);
+    for (var e = 0u; e < na; e++) {
+        let x = corner_at(a, e, h);
+        let d = corner_at(a, next_corner(a, e), h) - x;
+        let t = clamp(dot(cb - x, d) / max(dot(d, d), 1.0e-30), 0.0, 1.0);
+        let off = x + t * d - cb;
+        if (dot(off, off) <= rb * rb) {
+            edges |= 1u << e;
+            mean += x + 0.5 * d;
+        }
+    }
+    if (edges == 0u) { return r; }
+    // A circle holding those edges, with room for f32 rounding (1e-4 relative, 1e-5
+    // of the polygon): a half-plane that holds all of it leaves every point of them
+    // inside, exactly as cutting by it would.
+    let c = mean / f32(countOneBits(edges));
+    var rho2 = 0.0;
+    var left = edges;
+    while (left != 0u) {
+        let e = firstTrailingBit(left);
+        left &= left - 1u;
+        let x = corner_at(a, e, h) - c;
+        let y = corner_at(a, next_corner(a, e), h) - c;
+        rho2 = max(rho2, max(dot(x, x), dot(y, y)));
+    }
+    let rho = sqrt(rho2) * (1.0 + 1.0e-4) + 1.0e-5 * (*a).reach;
+    var planes = 0u;
+    for (var f = 0u; f < nb; f++) {
+        let ba = corner_at(b, f, h);
+        let bb = corner_at(b, next_corner(b, f), h);
+        let m = vec2<f32>(-(bb.y - ba.y), bb.x - ba.x);
+        let side = dot(c - ba, m);
+        let reach = rho * length(m);
+        if (side <= -reach) { return r; }
+        if (side < reach) { planes |= 1u << f; }
+    }
+    left = edges;
+    while (left != 0u) {
+        let e = firstTrailingBit(left);
+        left &= left - 1u;
+        let x = corner_at(a, e, h);
+        let y = corner_at(a, next_corner(a, e), h);
+        // Cyrus-Beck: the interval [t0, t1] of x-y in the half-planes (z - b_f).m_f >= 0
+        // (counter-clockwise: inside is to the left of each edge).
+        var t0 = 0.0;
+        var t1 = 1.0;
+        var fin = 0u;
+        var fout = 0u;
+        var x_in = true;
+        var empty = false;
+        var cutting = planes;
+        while (cutting != 0u) {
+            let f = firstTrailingBit(cutting);
+            cutting &= cutting - 1u;
+            let ba = corner_at(b, f, h);
+            let bb = corner_at(b, next_corner(b, f), h);
+            let m = vec2<f32>(-(bb.y - ba.y), bb.x - ba.x);
+            let dx = dot(x - ba, m);
+            let dy = dot(y - ba, m);
+            x_in = x_in && dx >= 0.0;
+            if (dx < 0.0 && dy < 0.0) { empty = true; }
+            let s = dx / (dx - dy);
+            if (dx < 0.0 && dy >= 0.0 && s > t0) { t0 = s; fin = f + 1u; }
+            if (dx >= 0.0 && dy < 0.0 && s < t1) { t1 = s; fout = f + 1u; }
+        }
+        if (x_in) {
+            r.corners |= 1u << e;
+            r.sum += x;
+        }
+        if (!empty && t0 < t1) {
+            r.pieces |= 1u << e;
+            r.area2 += cross2(x + t0 * (y - x), x + t1 * (y - x));
+            if (fin > 0u) {
+                r.cross |= 1u << (2u * e);
+                r.entry = put_nibble(r.entry, e, fin - 1u);
+                r.cross_sum += x + t0 * (y - x);
+            }
+            if (fout > 0u) {
+                r.cross |= 2u << (2u * e);
+                r.exit = put_nibble(r.exit, e, fout - 1u);
+                r.cross_sum += x + t1 * (y - x);
+            }
+        }
+    }
+    return r;
+}
+
+// Crossing k of `in_p` (bit k of `cross`): p's edge and q's edge that cross there.
+fn crossing_edges(in_p: Inside, k: u32) -> vec2<u32> {
+    let e = k >> 1u;
+    return vec2<u32>(e, nibble(select(in_p.entry, in_p.exit, (k & 1u) == 1u), e));
+}
+
+// Crossing k in f32 clip coordinates.
+fn crossing_at(p: ptr<function, Outline>, q: ptr<function, Outline>, in_p: Inside, k: u32,
+               h: vec2<i32>) -> vec2<f32> {
+    let pq = crossing_edges(in_p, k);
+    let x = corner_at(p, pq.x, h);
+    let y = corner_at(p, next_corner(p, pq.x), h);
+    return x + edge_cut(x, y, q, pq.y, h) * (y - x);
+}
+
+// The exact (u, w) of up to four crossings (bit k of the p pass's `cross` in `key`),
+// each computed once: a crossing ends one part of an edge and starts the next, and a
+// crossing's (u, w) is the costliest value here. Two polygons resting on each other
+// cross twice; only a deep overlap crosses more than four times, and its area is then
+// large enough for f32 (`polygon_polygon`).
+struct Crossings {
+    key: vec4<u32>,
+    u: vec4<f32>,
+    w: vec4<f32>,
+};
+
+fn crossings_uw(p: ptr<function, Outline>, q: ptr<function, Outline>, in_p: Inside,
+                fr: Frame) -> Crossings {
+    var c = Crossings(vec4<u32>(64u), vec4<f32>(0.0), vec4<f32>(0.0));
+    var left = in_p.cross;
+    var slot = 0u;
+    while (left != 0u) {
+        let k = firstTrailingBit(left);
+        left &= left - 1u;
+        let pq = crossing_edges(in_p, k);
+        let uw = crossing_uw(p, pq.x, q, pq.y, fr);
+        let here = vec4<u32>(0u, 1u, 2u, 3u) == vec4<u32>(slot);
+        c.key = select(c.key, vec4<u32>(k), here);
+        c.u = select(c.u, vec4<f32>(uw.x), here);
+        c.w = select(c.w, vec4<f32>(uw.y), here);
+        slot++;
+    }
+    return c;
+}
+
+// Crossing k's (u, w) and 1, or 0 if it is not among them.
+fn crossing_of(c: Crossings, k: u32) -> vec3<f32> {
+    let hit = select(vec4<f32>(0.0), vec4<f32>(1.0), c.key == vec4<u32>(k));
+    return vec3<f32>(dot(hit, c.u), dot(hit, c.w), dot(hit, vec4<f32>(1.0)));
+}
+
+// The trapezoid sum 1/2 sum (w_s + w_e)(u_s - u_e) over the parts of a's edges inside
+// the other polygon (a_is_p: a is p, the other q), each end exact (`corner_uw`, or the
+// crossing's from `c`); and whether a crossing was missing from `c`. A crossing is
+// named by the p pass's bit: p entering q through edge f is bit 2f, and there q's edge
+// leaves p; p leaving q is bit 2f + 1, and there q's edge enters p.
+fn pieces_area(a: ptr<function, Outline>, ins: Inside, a_is_p: bool, fr: Frame,
+               c: Crossings) -> vec2<f32> {
+    var area = 0.0;
+    var missing = 0.0;
+    var left = ins.pieces;
+    while (left != 0u) {
+        let e = firstTrailingBit(left);
+        left &= left - 1u;
+        var s = corner_uw(a, e, fr);
+        var t = corner_uw(a, next_corner(a, e), fr);
+        if ((ins.cross & (1u << (2u * e))) != 0u) {
+            let k = select(2u * nibble(ins.entry, e) + 1u, 2u * e, a_is_p);
+            let x = crossing_of(c, k);
+            s = x.xy;
+            missing += 1.0 - x.z;
+        }
+        if ((ins.cross & (2u << (2u * e))) != 0u) {
+            let k = select(2u * nibble(ins.exit, e), 2u * e + 1u, a_is_p);
+            let x = crossing_of(c, k);
+            t = x.xy;
+            missing += 1.0 - x.z;
+        }
+        area += (s.y + t.y) * (s.x - t.x);
+    }
+    return vec2<f32>(0.5 * area, missing);
+}
 
 // Area contact of polygon p (centre ci) with polygon q (centre cj), in clip
 // coordinates: f32 units relative to the frame point h. Area in units^2.
 fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2<i32>,
-                   ci: vec2<f32>, cj: vec2<f32>, only_area: bool) -> AreaContact {
-    var c: Clip;
-    var count = array<u32, 2>((*p).n, 0u);
+                   ci: vec2<f32>, cj: vec2<f32>) -> AreaContact {
+    let in_p = edges_inside(p, q, h);
+    if (in_p.pieces == 0u) { return no_contact(); }
+    let in_q = edges_inside(q, p, h);
+    let n_p = countOneBits(in_p.corners);
+    let n_q = countOneBits(in_q.corners);
+    let n_x = countOneBits(in_p.cross);
+    if (n_p + n_q + n_x < 3u) { return no_contact(); }
     var r2 = 0.0;
     for (var k = 0u; k < (*p).n; k++) {
-        let x = corner_at(p, k, h);
-        c.v[0][k] = x;
-        c.line[0][k] = k;
-        r2 = max(r2, dot(x - ci, x - ci));
+        let x = corner_at(p, k, h) - ci;
+        r2 = max(r2, dot(x, x));
     }
-    let r = sqrt(r2);
-    var cur = 0u;
-    let nq = (*q).n;
-    // The edges are clipped from the corner of q that points most towards p (overlap.rs
-    // `clip_by`): its two edges cut p down to the few corners near the contact first.
-    var first = 0u;
-    var most = dot(corner_at(q, 0u, h), ci - cj);
-    for (var k = 1u; k < nq; k++) {
-        let along = dot(corner_at(q, k, h), ci - cj);
-        if (along > most) { most = along; first = k; }
-    }
-    first = (first + nq - 1u) % nq;
-    var a = corner_at(q, first, h);
-    // After the first two clips the few corners left lie in a small circle: an edge
-    // whose half-plane holds it with room for f32 rounding (1e-4 relative, 1e-5 of r)
-    // leaves every corner where it is, as clipping by it would (overlap.rs `clip_by`).
-    var cap = vec3<f32>(0.0, 0.0, -1.0);
-    for (var e = 0u; e < nq; e++) {
-        if (e == 2u && count[cur] > 0u) {
-            let bc = bounding_circle(&c, cur, count[cur]);
-            cap = vec3<f32>(bc.xy, sqrt(bc.z) * (1.0 + 1.0e-4) + 1.0e-5 * r);
-        }
-        let k = (first + e) % nq;
-        let b = corner_at(q, (k + 1u) % nq, h);
-        let m = vec2<f32>(-(b.y - a.y), b.x - a.x);
-        let reach = r * length(m);
-        let centre = dot(ci - a, m);
-        let start = a;
-        a = b;
-        // Edges whose half-plane holds all of p's circle change nothing.
-        if (centre >= reach) { continue; }
-        if (centre <= -reach) { count[cur] = 0u; break; }
-        if (cap.z >= 0.0) {
-            let side = dot(cap.xy - start, m);
-            if (side > 0.0 && side * side > cap.z * cap.z * dot(m, m)) { continue; }
-        }
-        count[1u - cur] = clip_lines(&c, cur, count[cur], start, m, Q_LINE + k);
-        cur = 1u - cur;
-        if (count[cur] == 0u) { break; }
-    }
-    let n = count[cur];
-    if (n < 3u) { return no_contact(); }
-    // The f32 area decides only where it is clearly positive or negative; a sliver
-    // within its rounding (~1e-6 extent x scale) is decided by the exact area below.
-    let scale = length(cj - ci) + r;
-    let sh = shoelace(&c, cur, n);
-    let margin = 1.0e-6 * sh.y * scale;
-    if (sh.x <= -margin) { return no_contact(); }
-    var g = no_contact();
-    g.area = sh.x;
-    g.found = true;
-    if (only_area && sh.x > margin) { return g; }
-    // The two crossings farthest apart.
+    let scale = length(cj - ci) + sqrt(r2);
+    // The two crossings farthest apart (src/overlap.rs `farthest_pair`).
     var best = -1.0;
     var xa = vec2<f32>(0.0);
     var xb = vec2<f32>(0.0);
-    var ia = 0u;
-    var ib = 0u;
-    for (var i = 0u; i < n; i++) {
-        if (origin_of(c.line[cur][(i + n - 1u) % n], c.line[cur][i]) != ORIGIN_CROSSING) { continue; }
-        for (var j = i + 1u; j < n; j++) {
-            if (origin_of(c.line[cur][j - 1u], c.line[cur][j]) != ORIGIN_CROSSING) { continue; }
-            let d = length(c.v[cur][j] - c.v[cur][i]);
-            if (d > best) { best = d; xa = c.v[cur][i]; xb = c.v[cur][j]; ia = i; ib = j; }
+    var ka = 0u;
+    var kb = 0u;
+    var left = in_p.cross;
+    while (left != 0u) {
+        let a = firstTrailingBit(left);
+        left &= left - 1u;
+        let pa = crossing_at(p, q, in_p, a, h);
+        var others = left;
+        while (others != 0u) {
+            let b = firstTrailingBit(others);
+            others &= others - 1u;
+            let pb = crossing_at(p, q, in_p, b, h);
+            let d = length(pb - pa);
+            if (d > best) { best = d; xa = pa; xb = pb; ka = a; kb = b; }
         }
     }
+    var g = no_contact();
+    g.found = true;
     var along = vec2<f32>(0.0, 1.0);
     if (length(cj - ci) > 0.0) { along = (ci - cj) / length(cj - ci); }
     // The f32 crossings carry ~6e-8 scale: a chord several times that still gives the
     // frame's direction; the chord's size and the normal come from the exact crossings.
     let chord = length(xb - xa);
-    if (best >= 0.0 && chord > 4.0e-7 * scale) {
+    var fr: Frame;
+    let framed = best >= 0.0 && chord > 4.0e-7 * scale;
+    var nn = along;
+    var s = vec2<f32>(0.0);
+    if (framed) {
         let t = (xb - xa) / chord;
-        var nn = vec2<f32>(-t.y, t.x);
-        let s = 0.5 * (xa + xb);
+        nn = vec2<f32>(-t.y, t.x);
+        s = 0.5 * (xa + xb);
         // Corners of i inside j lie on j's side of the line, corners of j on i's side.
-        var side = 0.0;
-        for (var k = 0u; k < n; k++) {
-            let o = origin_of(c.line[cur][(k + n - 1u) % n], c.line[cur][k]);
-            if (o == ORIGIN_P) { side += dot(nn, c.v[cur][k] - s); }
-            if (o == ORIGIN_Q) { side -= dot(nn, c.v[cur][k] - s); }
-        }
+        let side = dot(nn, in_p.sum - f32(n_p) * s) - dot(nn, in_q.sum - f32(n_q) * s);
         if (side > 0.0 || (side == 0.0 && dot(nn, ci - cj) < 0.0)) { nn = -nn; }
+        fr = make_frame(h, s, nn);
+    } else {
+        // Fewer than two crossings or a vanishing chord: n along the centres, S at the
+        // mean of the overlap's corners.
+        g.point = (in_p.sum + in_q.sum + in_p.cross_sum) / f32(n_p + n_q + n_x);
+        fr = make_frame(h, g.point, nn);
+    }
+    let c = crossings_uw(p, q, in_p, fr);
+    if (framed) {
         // The crossings again, exact: one between two nearly parallel edges is poorly
-        // placed along them by the f32 clip.
-        let fr = make_frame(h, s, nn);
-        let ua = vertex_uw(p, q, &c, cur, n, ia, fr);
-        let ub = vertex_uw(p, q, &c, cur, n, ib, fr);
+        // placed along them by the f32 cut.
+        let xa3 = crossing_of(c, ka);
+        let xb3 = crossing_of(c, kb);
+        let ua = xa3.xy;
+        let ub = xb3.xy;
         let d = ub - ua;
         let len = length(d);
-        if (len > 1.0e-7 * scale) {
+        if (len > 1.0e-7 * scale && xa3.z * xb3.z > 0.0) {
             let tt = (d.x * fr.t + d.y * fr.n) / len;
             g.n = vec2<f32>(-tt.y, tt.x) * sign(dot(vec2<f32>(-tt.y, tt.x), nn));
             g.chord = len;
@@ -402,12 +570,16 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
             g.point = s;
             g.chord = chord;
         }
-        g.area = exact_area(p, q, &c, cur, n, fr);
     } else {
         g.n = along;
-        g.point = corner_mean(&c, cur, n);
         g.chord = 0.0;
-        g.area = exact_area(p, q, &c, cur, n, make_frame(h, g.point, g.n));
+    }
+    let from_p = pieces_area(p, in_p, true, fr, c);
+    let from_q = pieces_area(q, in_q, false, fr, c);
+    g.area = from_p.x + from_q.x;
+    if (from_p.y + from_q.y > 0.0) {
+        // More than four crossings: a deep overlap, whose f32 area is good enough.
+        g.area = 0.5 * (in_p.area2 + in_q.area2);
     }
     if (g.area <= 0.0) { return no_contact(); }
     g.l = reduced_arm(length(g.point - ci), length(g.point - cj), scale);
@@ -420,8 +592,7 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
 // the area is then recomputed exactly, as for two polygons: w is a corner's exact
 // distance from the wall's line (zero on it, interpolated along p's edge where an edge
 // crosses an end line), u is measured from p's deepest corner by exact integer offsets.
-fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: WallLine,
-                only_area: bool) -> AreaContact {
+fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: WallLine) -> AreaContact {
     let ab = wb - wa;
     let len = length(ab);
     if (len == 0.0) { return no_contact(); }
@@ -451,7 +622,6 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: Wall
     var g = no_contact();
     g.area = sh.x;
     g.found = true;
-    if (only_area && sh.x > margin) { return g; }
     let scale = len + r;
     g.n = m;
     g.point = corner_mean(&c, 1u, n);
@@ -459,7 +629,7 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: Wall
     // The area from the lines: 1/2 sum (w_k + w_k+1)(u_k - u_k+1); the chord from the
     // u of the corners on the wall's line.
     let t = vec2<f32>(m.y, -m.x);
-    let base = (*p).w[deepest];
+    let base = ow(p, deepest);
     let first = wall_uw(p, &c, n, 0u, l, t, base);
     var prev = first;
     var a = 0.0;
@@ -523,14 +693,14 @@ fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, l:
 
 // Corner m along t from the integer point `base` (exact offset, one rounding).
 fn corner_u(p: ptr<function, Outline>, m: u32, base: vec2<i32>, t: vec2<f32>) -> f32 {
-    return dot(vec2<f32>((*p).w[m] - base) + corner_e(p, m), t);
+    return dot(vec2<f32>(ow(p, m) - base) + corner_e(p, m), t);
 }
 
 // Corner m's distance from the wall's line (units, positive on the centre's side): the
 // centre's exact (c - a).q plus the corner's w.q in 64-bit integers, and the small
 // parts (remainders, the turn beta of q).
 fn corner_wall_w(p: ptr<function, Outline>, m: u32, l: WallLine) -> f32 {
-    let w = (*p).w[m];
+    let w = ow(p, m);
     let exact = add64(l.c64, add64(smul(w.x, l.q.x), smul(w.y, l.q.y)));
     return i64_to_f32(exact) / Q30 + l.small + dot(corner_e(p, m), l.n)
         - l.beta * dot(vec2<f32>(w), l.t) - l.alpha * dot(vec2<f32>(w), l.n);
@@ -539,18 +709,16 @@ fn corner_wall_w(p: ptr<function, Outline>, m: u32, l: WallLine) -> f32 {
 // The area contact of particle i with particle j (both polygons), in length units with
 // the force point relative to centre i. Corners are exact in a frame at j's centre and
 // clipped in f32 relative to the middle of the pair.
-fn polygons_ij(i: u32, j: u32, only_area: bool) -> AreaContact {
+fn polygons_ij(i: u32, j: u32) -> AreaContact {
     let o = offset_ij(i, j);
     // Centres more than 1.5 cells apart cannot touch (and their corners would not fit
     // an i32 in the frame).
     if (!o.near || any(abs(o.d) > vec2<i32>(1610612736))) { return no_contact(); }
-    var p: Outline;
-    var q: Outline;
-    load_outline(i, o.d, o.e, &p);
-    load_outline(j, vec2<i32>(0), vec2<f32>(0.0), &q);
+    var p = load_outline(i, o.d, o.e);
+    var q = load_outline(j, vec2<i32>(0), vec2<f32>(0.0));
     let h = o.d / vec2<i32>(2);
     let ci = vec2<f32>(o.d - h) + o.e;
-    var g = polygon_polygon(&p, &q, h, ci, vec2<f32>(-h), only_area);
+    var g = polygon_polygon(&p, &q, h, ci, vec2<f32>(-h));
     let u = params.unit;
     g.area *= u * u;
     g.chord *= u;
@@ -566,16 +734,15 @@ fn offset_units(o: Offset) -> vec2<f32> {
 }
 
 // The area contact of particle i with wall w, in length units in i's frame.
-fn polygon_wall_iw(i: u32, w: u32, only_area: bool) -> AreaContact {
+fn polygon_wall_iw(i: u32, w: u32) -> AreaContact {
     let s = state[i];
     let wall = walls[w];
     let oa = offset(wall.a_anchor, wall.a_frac, wall.a_rem, s.anchor, s.frac, s.q[0].xy);
     let ob = offset(wall.b_anchor, wall.b_frac, wall.b_rem, s.anchor, s.frac, s.q[0].xy);
     let l = wall_line(i, w);
     if (!l.near) { return no_contact(); }
-    var p: Outline;
-    load_outline(i, vec2<i32>(0), vec2<f32>(0.0), &p);
-    var g = polygon_wall(&p, offset_units(oa), offset_units(ob), l, only_area);
+    var p = load_outline(i, vec2<i32>(0), vec2<f32>(0.0));
+    var g = polygon_wall(&p, offset_units(oa), offset_units(ob), l);
     let u = params.unit;
     g.area *= u * u;
     g.chord *= u;
@@ -720,7 +887,7 @@ fn depth_in_circle(w: vec2<i32>, e: vec2<f32>, r_units: u32, r_rem: f32) -> f32 
 
 // Corner a minus corner b of an outline, from the exact integer offset (one rounding).
 fn corner_delta(p: ptr<function, Outline>, a: u32, b: u32) -> vec2<f32> {
-    return vec2<f32>((*p).w[a] - (*p).w[b]) + (corner_e(p, a) - corner_e(p, b));
+    return vec2<f32>(ow(p, a) - ow(p, b)) + (corner_e(p, a) - corner_e(p, b));
 }
 
 // How far along the unit vector u from the point x, `depth` inside the circle of radius
@@ -739,8 +906,7 @@ fn circle_reach(x: vec2<f32>, u: vec2<f32>, depth: f32, r: f32) -> f32 {
 fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
     let o = offset_ij(poly, disk);
     if (!o.near || any(abs(o.d) > vec2<i32>(1610612736))) { return no_contact(); }
-    var p: Outline;
-    load_outline(poly, o.d, o.e, &p);
+    var p = load_outline(poly, o.d, o.e);
     let ru = props[disk].radius_units;
     let rr = props[disk].radius_rem;
     let r = f32(ru) + rr;                       // units
@@ -749,7 +915,7 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
     var inside = 0u;
     var mask = 0u;
     for (var m = 0u; m < np; m++) {
-        let dm = depth_in_circle(p.w[m], corner_e(&p, m), ru, rr);
+        let dm = depth_in_circle(ow(&p, m), corner_e(&p, m), ru, rr);
         if (dm > 0.0) { inside++; mask |= 1u << m; }
     }
     // Edges with both ends outside that the circle cuts twice (`cut` of them with the
@@ -786,7 +952,7 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
         // exact integer products (issue 19).
         let a = edge;
         let b = (edge + 1u) % np;
-        let abi = p.w[b] - p.w[a];
+        let abi = ow(&p, b) - ow(&p, a);
         let ab = vec2<f32>(abi);
         let len = length(ab);
         let t = ab / len;
@@ -795,9 +961,9 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
         let beta = i64_to_f32(add64(smul(nq.x, abi.x), smul(nq.y, abi.y))) / (Q30 * len);
         let q2 = add64(smul(nq.x, nq.x), smul(nq.y, nq.y));
         let alpha = 0.5 * i64_to_f32(sub64(q2, vec2<u32>(0u, 0x10000000u))) / (Q30 * Q30);
-        let wq = add64(smul(p.w[a].x, nq.x), smul(p.w[a].y, nq.y));
+        let wq = add64(smul(ow(&p, a).x, nq.x), smul(ow(&p, a).y, nq.y));
         let exact = add64(wq, vec2<u32>(ru << 30u, ru >> 2u));
-        let w_t = dot(vec2<f32>(p.w[a]), t);
+        let w_t = dot(vec2<f32>(ow(&p, a)), t);
         let delta = i64_to_f32(exact) / Q30 + rr + dot(corner_e(&p, a), nout)
             - beta * w_t - alpha * i64_to_f32(wq) / Q30;
         if (delta <= 0.0) { return no_contact(); }
@@ -829,9 +995,9 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
             let v1 = corner_at(&p, first, vec2<i32>(0));
             let u1 = normalize(corner_delta(&p, (first + np - 1u) % np, first));
             let u2 = normalize(corner_delta(&p, (last + 1u) % np, last));
-            let s1 = circle_reach(v1, u1, depth_in_circle(p.w[first], corner_e(&p, first), ru, rr), r);
+            let s1 = circle_reach(v1, u1, depth_in_circle(ow(&p, first), corner_e(&p, first), ru, rr), r);
             let v2 = corner_at(&p, last, vec2<i32>(0));
-            let s2 = circle_reach(v2, u2, depth_in_circle(p.w[last], corner_e(&p, last), ru, rr), r);
+            let s2 = circle_reach(v2, u2, depth_in_circle(ow(&p, last), corner_e(&p, last), ru, rr), r);
             var twice = 0.0;
             var prev = -s1 * u1;
             for (var k = 1u; k < count; k++) {
@@ -925,17 +1091,24 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
 }
 
 // The area contact of particles i and j, whatever their shapes (force point relative
-// to centre i).
-fn area_contact(i: u32, j: u32, only_area: bool) -> AreaContact {
+// to centre i). The pipelines are built for the shapes a scene has (`POLYGON_SHAPES`,
+// `DISK_SHAPES`): the branches of the others compile away, since a thread that skips a
+// branch still waits for its neighbours that take it, and a software adapter runs every
+// branch of every thread.
+fn area_contact(i: u32, j: u32) -> AreaContact {
+    if (!DISK_SHAPES) { return polygons_ij(i, j); }
+    if (!POLYGON_SHAPES) { return disks_area_ij(i, j); }
     let pi = props[i].shape.y > 0u;
     let pj = props[j].shape.y > 0u;
-    if (pi && pj) { return polygons_ij(i, j, only_area); }
+    if (pi && pj) { return polygons_ij(i, j); }
     if (pi) { return polygon_disk_ij(i, j, true); }
     if (pj) { return polygon_disk_ij(j, i, false); }
     return disks_area_ij(i, j);
 }
 
-fn area_contact_wall(i: u32, w: u32, only_area: bool) -> AreaContact {
-    if (props[i].shape.y > 0u) { return polygon_wall_iw(i, w, only_area); }
+fn area_contact_wall(i: u32, w: u32) -> AreaContact {
+    if (!DISK_SHAPES) { return polygon_wall_iw(i, w); }
+    if (!POLYGON_SHAPES) { return disk_wall_area(i, w); }
+    if (props[i].shape.y > 0u) { return polygon_wall_iw(i, w); }
     return disk_wall_area(i, w);
 }

@@ -706,6 +706,69 @@ fn polygon_overlaps_are_exact_down_to_1e_6_d() {
     );
 }
 
+#[test]
+fn deep_polygon_overlaps_with_many_crossings_agree_with_the_cpu() {
+    // polygon.wgsl keeps the exact (u, w) of four crossings in registers; a deeper
+    // overlap (two 12-gons nearly on top of each other cross up to 24 times) takes the
+    // f32 area of its edges' parts inside each other instead. Pairs of 12-gons and of
+    // heptagons with centres 0.02-0.8 d apart, at random orientations: A/l, the normal
+    // and the arm agree with the f64 CPU path.
+    let mut rng = Rng::new(29);
+    let n = 40;
+    let mut blocks = Vec::new();
+    for (corners, diameter) in [(12, 1.0), (7, 1.1)] {
+        let list: Vec<_> = (0..n)
+            .flat_map(|k| {
+                let (x, z) = (3.0 * k as f64, if corners == 7 { 5.0 } else { 2.0 });
+                let s = rng.range(0.02, 0.8);
+                let t = rng.range(0.0, std::f64::consts::TAU);
+                [
+                    json!({ "position": [x, z], "diameter": diameter,
+                            "theta": rng.range(-3.2, 3.2) }),
+                    json!({ "position": [x + s * t.cos(), z + s * t.sin()],
+                            "diameter": diameter, "theta": rng.range(-3.2, 3.2) }),
+                ]
+            })
+            .collect();
+        blocks.push(json!({ "kind": "list", "material": "m", "particles": list,
+                            "polygon": { "corners": corners } }));
+    }
+    let mut v = common::scene_value(polygons(), json!(blocks));
+    v["domain"] = json!({ "x": [-3.0, 3.0 * n as f64 + 5.0], "z": [-2.0, 8.0] });
+    v["limits"] = json!({ "max_overlap": 1e9 });
+    let Some(gpu) = common::gpu("deep_polygon_overlaps") else {
+        return;
+    };
+    let mut g = GpuSimulation::with_gpu(common::sim(&v), gpu).expect("uploads");
+    let pairs = gpu_pairs(&mut g);
+    let host = g.download().clone();
+    let m = host.particles.len();
+    let (cpu, _) = cpu_contact_forces(&host, &pairs, &vec![0.0; pairs.len()]);
+    let out = g.read_contact_out(m * MAX_CONTACTS as usize);
+    let slots = touching_slots(&g);
+    assert_eq!(
+        pairs.len(),
+        2 * n,
+        "every pair overlaps, and only its own partner"
+    );
+    let (mut worst_delta, mut worst_n, mut worst_arm) = (0.0f64, 0.0f64, 0.0f64);
+    for (k, &slot) in slots.iter().enumerate() {
+        let (o, c) = (&out[slot], &cpu[k]);
+        worst_delta = worst_delta.max((o.info[2] as f64 - c.overlap).abs() / c.overlap);
+        worst_n = worst_n.max((o.geo[0] as f64 - c.n[0]).hypot(o.geo[1] as f64 - c.n[1]));
+        worst_arm = worst_arm.max((o.geo[2] as f64 - c.arm[0]).hypot(o.geo[3] as f64 - c.arm[1]));
+    }
+    eprintln!("A/l {worst_delta:.2e} relative, normal {worst_n:.2e}, arm {worst_arm:.2e} d");
+    assert!(
+        worst_delta < 1e-4,
+        "A/l differs by {worst_delta:.2e} relative"
+    );
+    assert!(
+        worst_n < 1e-3 && worst_arm < 1e-3,
+        "normal {worst_n:.2e}, arm {worst_arm:.2e} d"
+    );
+}
+
 /// Touching pairs with disks under the overlap-area law: a regular 12-gon and a disk
 /// along a face normal, an irregular heptagon and a disk from a random direction (corner
 /// first, mostly), two disks; each pushed together by a random gap. And disks resting on

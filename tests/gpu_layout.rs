@@ -133,6 +133,7 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("HALT_NOT_FINITE", c::HALT_NOT_FINITE as f64),
         ("HALT_CONTACTS_FULL", c::HALT_CONTACTS_FULL as f64),
         ("HALT_TABLE_FULL", c::HALT_TABLE_FULL as f64),
+        ("MAX_WORKGROUPS", talus::gpu::MAX_WORKGROUPS as f64),
         ("MAX_CLIP", talus::overlap::MAX_CLIP as f64),
         ("Q_LINE", talus::overlap::Q_LINE as f64),
         ("WALL_LINE", talus::overlap::WALL_LINE as f64),

@@ -38,6 +38,8 @@ pub(super) struct Buffers {
     pub(super) table: wgpu::Buffer,
     /// The rebuild stages' indirect dispatch arguments (shaders/plan.wgsl).
     pub(super) dispatch_args: wgpu::Buffer,
+    /// The candidates as one list (`PairList` in common.wgsl).
+    pub(super) pairs: wgpu::Buffer,
 }
 
 /// What the buffers hold at the upload (the others start zeroed).
@@ -122,6 +124,10 @@ impl Buffers {
                     | wgpu::BufferUsages::INDIRECT
                     | wgpu::BufferUsages::COPY_SRC,
             }),
+            pairs: {
+                // The count, then a slot per candidate.
+                zeroed("pairs", 4 + n * m * 4)
+            },
         }
     }
 
@@ -160,6 +166,7 @@ impl Buffers {
             &b.ids_next,
             &b.contact_info,
             &b.contact_geo,
+            &b.pairs,
         ];
         let entries0: Vec<_> = group0_buffers
             .iter()

@@ -188,6 +188,8 @@ pub enum Kernel {
     Predict,
     Survey,
     PlanRebuild,
+    /// The workgroups of `contact_forces` under the overlap-area law (a thread per pair).
+    PlanPairs,
     ClearCells,
     CellIndex,
     ScanLevel0,
@@ -215,12 +217,13 @@ pub enum Kernel {
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 26] = [
+    pub const ALL: [Kernel; 27] = [
         Kernel::InsertCheck,
         Kernel::InsertPlace,
         Kernel::Predict,
         Kernel::Survey,
         Kernel::PlanRebuild,
+        Kernel::PlanPairs,
         Kernel::ClearCells,
         Kernel::CellIndex,
         Kernel::ScanLevel0,
@@ -252,6 +255,7 @@ impl Kernel {
             Kernel::Predict => ("predict", "predict"),
             Kernel::Survey => ("survey", "survey"),
             Kernel::PlanRebuild => ("plan", "plan_rebuild"),
+            Kernel::PlanPairs => ("plan", "plan_pairs"),
             Kernel::ClearCells => ("cell_index", "clear_cells"),
             Kernel::CellIndex => ("cell_index", "cell_index"),
             Kernel::ScanLevel0 => ("prefix_sum", "scan_level0"),
@@ -281,7 +285,7 @@ impl Kernel {
 /// table) and of group 2 (the indirect dispatch arguments, bound only to
 /// `plan_rebuild`: a buffer cannot be an indirect argument and writable storage in one
 /// dispatch).
-pub const GROUP0_STORAGE: u32 = 26;
+pub const GROUP0_STORAGE: u32 = 27;
 pub const GROUP1_STORAGE: u32 = 1;
 pub const GROUP2_STORAGE: u32 = 1;
 
@@ -298,6 +302,53 @@ fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
+/// What the contact kernels are built for: the overlap-area law (`POLYGONS` in
+/// polygon.wgsl), the shapes the scene has now or will have from its sources and
+/// layers, and whether it has walls. The branches of the others compile away: a GPU
+/// thread that skips a branch waits for its neighbours that take it, and a software
+/// adapter runs every branch of every thread (on lavapipe a polygon pile's contacts
+/// took 83 ms a step with the disk and wall branches in, 55 ms without them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Build {
+    pub area_law: bool,
+    pub polygons: bool,
+    pub disks: bool,
+    pub walls: bool,
+    /// A software adapter (lavapipe): `contact_forces` takes four pairs to a thread
+    /// under the overlap-area law instead of one (`PAIRS_PER_THREAD`, plan.wgsl).
+    pub software: bool,
+}
+
+impl Build {
+    pub fn of(sim: &crate::sim::Simulation, adapter: &wgpu::AdapterInfo) -> Self {
+        use crate::scene::Creation;
+        let (mut polygons, mut disks) = (false, false);
+        for c in &sim.scene.particles {
+            let polygon = match c {
+                Creation::LatticePile(p) => p.polygon.is_some(),
+                Creation::Row(r) => r.polygon.is_some(),
+                Creation::PointSource(s) => s.polygon.is_some(),
+                Creation::Layered(l) => l.polygon.is_some(),
+                Creation::List(l) => l.polygon.is_some(),
+            };
+            polygons |= polygon;
+            disks |= !polygon;
+        }
+        // Particles as they are (a checkpoint's, or set by a test).
+        for s in &sim.particles.shape {
+            polygons |= !s.is_empty();
+            disks |= s.is_empty();
+        }
+        Self {
+            area_law: matches!(sim.law, crate::law::ContactLaw::OverlapArea(_)),
+            polygons,
+            disks,
+            walls: !sim.walls.is_empty(),
+            software: adapter.device_type == wgpu::DeviceType::Cpu,
+        }
+    }
+}
+
 pub struct Pipelines {
     pub group0: wgpu::BindGroupLayout,
     pub group1: wgpu::BindGroupLayout,
@@ -306,9 +357,8 @@ pub struct Pipelines {
 }
 
 impl Pipelines {
-    /// `polygons`: build the contact kernels with their polygon branches
-    /// (`POLYGONS` in polygon.wgsl).
-    pub fn new(device: &wgpu::Device, polygons: bool) -> Self {
+    /// The pipelines of every kernel, the contact kernels built for `build`.
+    pub fn new(device: &wgpu::Device, build: Build) -> Self {
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
             binding: 0,
             visibility: wgpu::ShaderStages::COMPUTE,
@@ -356,7 +406,14 @@ impl Pipelines {
             .iter()
             .map(|&k| {
                 let (module, entry) = k.entry();
-                let polygons = ("POLYGONS", if polygons { 1.0 } else { 0.0 });
+                let flag = |on: bool| if on { 1.0 } else { 0.0 };
+                let polygons = ("POLYGONS", flag(build.area_law));
+                let shapes = [
+                    polygons,
+                    ("POLYGON_SHAPES", flag(build.polygons)),
+                    ("DISK_SHAPES", flag(build.disks)),
+                    ("WALLS", flag(build.walls)),
+                ];
                 let record = (
                     "RECORD",
                     if k == Kernel::ContactForcesOnly {
@@ -366,15 +423,18 @@ impl Pipelines {
                     },
                 );
                 let ahead = ("AHEAD", if k == Kernel::CorrectAhead { 1.0 } else { 0.0 });
+                let per_thread = [("PAIRS_PER_THREAD", if build.software { 4.0 } else { 1.0 })];
+                let with_record = [shapes[0], shapes[1], shapes[2], shapes[3], record];
                 let constants: &[(&str, f64)] = match module {
                     "find_contacts" => &[polygons],
-                    "contact_forces" => &[polygons, record],
+                    "contact_forces" => &with_record,
                     "correct" => &[ahead],
+                    "plan" if k == Kernel::PlanPairs => &per_thread,
                     _ => &[],
                 };
                 let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(entry),
-                    layout: Some(if k == Kernel::PlanRebuild {
+                    layout: Some(if matches!(k, Kernel::PlanRebuild | Kernel::PlanPairs) {
                         &plan_layout
                     } else {
                         &layout

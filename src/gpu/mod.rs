@@ -284,7 +284,7 @@ impl GpuSimulation {
         };
         let dev = &gpu.device;
         let buffers = Buffers::new(dev, &params, cells, &initial);
-        let pipelines = Pipelines::new(dev, matches!(sim.law, ContactLaw::OverlapArea(_)));
+        let pipelines = Pipelines::new(dev, kernels::Build::of(&sim, &gpu.info));
         let [group0, group1, group2] = buffers.bind_groups(dev, &pipelines);
         let lost_base = sim.lost;
         let inactive_at_upload = (sim.particles.len() - sim.particles.active_count()) as u64;

@@ -63,7 +63,11 @@ pub(super) const DISPATCH_ARGS_BYTES: usize = 16;
 /// The workgroups of one dispatch of kernel k.
 pub fn workgroups(p: &Params, k: Kernel) -> u64 {
     match k {
-        Kernel::InsertPlace | Kernel::ScanLevel2 | Kernel::AdvanceClock | Kernel::PlanRebuild => 1,
+        Kernel::InsertPlace
+        | Kernel::ScanLevel2
+        | Kernel::AdvanceClock
+        | Kernel::PlanRebuild
+        | Kernel::PlanPairs => 1,
         // Grid-stride loops: as many workgroups as one dispatch takes.
         Kernel::ClearCells => ceil_div(p.cells.max(p.n_cap) as u64, WG as u64).min(MAX_WORKGROUPS),
         Kernel::ScanLevel0 | Kernel::ScanAdd0 => p.scan_blocks1 as u64,
@@ -75,22 +79,29 @@ pub fn workgroups(p: &Params, k: Kernel) -> u64 {
 }
 
 /// The contents of `dispatch_args` at the upload: each rebuild stage's workgroups, then
-/// room for a step's arguments (shaders/plan.wgsl).
+/// room for a step's arguments, then `contact_forces`' under the overlap-area law (none
+/// until the first rebuild lists the pairs; shaders/plan.wgsl).
 pub(super) fn dispatch_args(p: &Params) -> Vec<u32> {
     let mut args: Vec<u32> = REBUILD_STAGES
         .iter()
         .flat_map(|&k| [workgroups(p, k) as u32, 1, 1, 0])
         .collect();
     args.resize(2 * args.len(), 0);
+    args.extend([0, 1, 1, 0]);
     args
 }
+
+/// Where `contact_forces`' arguments under the overlap-area law lie in `dispatch_args`.
+pub(super) const PAIR_ARGS_OFFSET: usize = 2 * REBUILD_STAGES.len() * DISPATCH_ARGS_BYTES;
 
 /// What the GPU path has encoded and submitted since the upload (`talus bench`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Counters {
-    /// Dispatches with a workgroup count fixed when encoded.
+    /// Dispatches that run workgroups every step: those with a count fixed when
+    /// encoded, and `contact_forces` under the overlap-area law (indirect, with the
+    /// workgroups of the pairs listed at the last rebuild).
     pub direct: u64,
-    /// Indirect dispatches: the rebuild stages, which run workgroups only at a rebuild.
+    /// The rebuild stages' indirect dispatches, which run workgroups only at a rebuild.
     pub indirect: u64,
     /// Submissions: batches of steps and readbacks.
     pub submissions: u64,
@@ -124,9 +135,21 @@ impl GpuSimulation {
         pass.set_bind_group(2, &self.group2, &[]);
     }
 
-    /// Records the dispatches of one kernel (for tests of single stages).
+    /// Records the dispatches of one kernel (for tests of single stages). Under the
+    /// overlap-area law `contact_forces` takes a thread per pair: `plan_pairs` writes
+    /// its workgroups from the pairs the last rebuild listed, and it is dispatched with
+    /// them (issue 14 item 5).
     pub fn encode_kernel(&self, pass: &mut wgpu::ComputePass, k: Kernel) {
-        self.dispatch(pass, k, workgroups(&self.params, k));
+        let per_pair = matches!(k, Kernel::ContactForces | Kernel::ContactForcesOnly)
+            && self.params.law == LAW_AREA;
+        if per_pair {
+            self.dispatch(pass, Kernel::PlanPairs, 1);
+            self.dispatches.set(self.dispatches.get() + 1);
+            pass.set_pipeline(&self.pipelines.pipelines[&k]);
+            pass.dispatch_workgroups_indirect(&self.buffers.dispatch_args, PAIR_ARGS_OFFSET as u64);
+        } else {
+            self.dispatch(pass, k, workgroups(&self.params, k));
+        }
     }
 
     /// Records a rebuild stage (the `REBUILD_STAGES[stage]`), dispatched with the

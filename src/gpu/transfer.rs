@@ -488,6 +488,7 @@ impl GpuSimulation {
             "table" => &b.table,
             "control" => &b.control,
             "dispatch_args" => &b.dispatch_args,
+            "pairs" => &b.pairs,
             _ => panic!("unknown buffer {name}"),
         };
         self.read_buffer(buf, 0, count)
