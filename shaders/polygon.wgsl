@@ -77,9 +77,16 @@ fn centre_at(o: ptr<function, Outline>, h: vec2<i32>) -> vec2<f32> {
     return vec2<f32>((*o).base - h) + (*o).e;
 }
 
+// Corner m as stored: whole units relative to the centre, rotated (`rotate_corners`).
+// Each read is a load from memory per thread, lane by lane on a software adapter: the
+// functions below take a corner once read (`c`) where they can.
+fn corner_rel(o: ptr<function, Outline>, m: u32) -> vec2<i32> {
+    return corners[(*o).first + m].zw;
+}
+
 // Corner m in whole units.
 fn ow(o: ptr<function, Outline>, m: u32) -> vec2<i32> {
-    return (*o).base + corners[(*o).first + m].zw;
+    return (*o).base + corner_rel(o, m);
 }
 
 // The corner after m.
@@ -87,14 +94,24 @@ fn next_corner(o: ptr<function, Outline>, m: u32) -> u32 {
     return select(m + 1u, 0u, m + 1u >= (*o).n);
 }
 
+// The remainder (units) of the corner read as c.
+fn e_of(o: ptr<function, Outline>, c: vec2<i32>) -> vec2<f32> {
+    return (*o).e + corner_spin(c, (*o).spin);
+}
+
+// The corner read as c in f32 units relative to the point h of the frame.
+fn at_of(o: ptr<function, Outline>, c: vec2<i32>, h: vec2<i32>) -> vec2<f32> {
+    return vec2<f32>((*o).base + c - h) + e_of(o, c);
+}
+
 // The remainder of corner m (units).
 fn corner_e(o: ptr<function, Outline>, m: u32) -> vec2<f32> {
-    return (*o).e + corner_spin(ow(o, m) - (*o).base, (*o).spin);
+    return e_of(o, corner_rel(o, m));
 }
 
 // Corner m in f32 units relative to the point h of the frame.
 fn corner_at(o: ptr<function, Outline>, m: u32, h: vec2<i32>) -> vec2<f32> {
-    return vec2<f32>(ow(o, m) - h) + corner_e(o, m);
+    return at_of(o, corner_rel(o, m), h);
 }
 
 // The polygon being clipped: corners and the line of each corner's outgoing edge, in
@@ -184,15 +201,15 @@ fn make_frame(h: vec2<i32>, s: vec2<f32>, n: vec2<f32>) -> Frame {
 // corner from the frame point o, rounded once in f32, so a corner near the contact
 // keeps f32's relative precision of its small distance from it (issue 19).
 fn corner_uw(o: ptr<function, Outline>, m: u32, fr: Frame) -> vec2<f32> {
-    let x = vec2<f32>(ow(o, m) - fr.o) + corner_e(o, m);
-    return vec2<f32>(dot(x, fr.t), corner_w(o, m, fr));
+    return corner_uw_of(o, corner_rel(o, m), fr);
 }
 
-// (x - o).n of corner m, from an exact 64-bit dot product.
-fn corner_w(o: ptr<function, Outline>, m: u32, fr: Frame) -> f32 {
-    let d = ow(o, m) - fr.o;
+// `corner_uw` of the corner read as c: w = (x - o).n from an exact 64-bit dot product.
+fn corner_uw_of(o: ptr<function, Outline>, c: vec2<i32>, fr: Frame) -> vec2<f32> {
+    let d = (*o).base + c - fr.o;
+    let e = e_of(o, c);
     let exact = add64(smul(d.x, fr.nq.x), smul(d.y, fr.nq.y));
-    return i64_to_f32(exact) / Q30 + dot(corner_e(o, m), fr.n);
+    return vec2<f32>(dot(vec2<f32>(d) + e, fr.t), i64_to_f32(exact) / Q30 + dot(e, fr.n));
 }
 
 // (b - a) x (x - a) of three corners (whole units and remainders), the large part exact
@@ -228,24 +245,24 @@ fn interpolate_w(wx: f32, wy: f32, s: vec2<f32>) -> vec2<f32> {
 // nearly parallel edges can be far off along them: its u is not used.)
 fn crossing_uw(p: ptr<function, Outline>, mp: u32, q: ptr<function, Outline>, mq: u32,
                fr: Frame) -> vec2<f32> {
-    let x = mp;
-    let y = (mp + 1u) % (*p).n;
-    let a = mq;
-    let b = (mq + 1u) % (*q).n;
-    let xw = ow(p, x);
-    let yw = ow(p, y);
-    let aw = ow(q, a);
-    let bw = ow(q, b);
-    let xe = corner_e(p, x);
-    let ye = corner_e(p, y);
-    let ae = corner_e(q, a);
-    let be = corner_e(q, b);
+    let cx = corner_rel(p, mp);
+    let cy = corner_rel(p, next_corner(p, mp));
+    let ca = corner_rel(q, mq);
+    let cb = corner_rel(q, next_corner(q, mq));
+    let xw = (*p).base + cx;
+    let yw = (*p).base + cy;
+    let aw = (*q).base + ca;
+    let bw = (*q).base + cb;
+    let xe = e_of(p, cx);
+    let ye = e_of(p, cy);
+    let ae = e_of(q, ca);
+    let be = e_of(q, cb);
     let s = crossing_param(cross_units(aw, ae, bw, be, xw, xe), cross_units(aw, ae, bw, be, yw, ye));
     let r = crossing_param(cross_units(xw, xe, yw, ye, aw, ae), cross_units(xw, xe, yw, ye, bw, be));
-    let px = corner_uw(p, x, fr);
-    let py = corner_uw(p, y, fr);
-    let qa = corner_uw(q, a, fr);
-    let qb = corner_uw(q, b, fr);
+    let px = corner_uw_of(p, cx, fr);
+    let py = corner_uw_of(p, cy, fr);
+    let qa = corner_uw_of(q, ca, fr);
+    let qb = corner_uw_of(q, cb, fr);
     let on_p = interpolate_w(px.y, py.y, s);
     let on_q = interpolate_w(qa.y, qb.y, r);
     if (on_p.y <= on_q.y) { return vec2<f32>(interpolate_w(px.x, py.x, s).x, on_p.x); }
@@ -305,10 +322,44 @@ fn edge_cut(x: vec2<f32>, y: vec2<f32>, b: ptr<function, Outline>, f: u32, h: ve
     return dx / (dx - dy);
 }
 
-fn edges_inside(a: ptr<function, Outline>, b: ptr<function, Outline>, h: vec2<i32>) -> Inside {
+// `run`: false skips it (every loop runs no turn: on a software adapter, which takes
+// every branch of every thread, a branch skipped costs as much as one taken, and a loop
+// of no turns costs one).
+// Up to eight half-planes (a point of the line, xy; its inward normal, zw).
+struct Planes {
+    p0: vec4<f32>,
+    p1: vec4<f32>,
+    p2: vec4<f32>,
+    p3: vec4<f32>,
+    p4: vec4<f32>,
+    p5: vec4<f32>,
+    p6: vec4<f32>,
+    p7: vec4<f32>,
+};
+
+fn keep_plane(k: Planes, slot: u32, v: vec4<f32>) -> Planes {
+    return Planes(select(k.p0, v, slot == 0u), select(k.p1, v, slot == 1u),
+                  select(k.p2, v, slot == 2u), select(k.p3, v, slot == 3u),
+                  select(k.p4, v, slot == 4u), select(k.p5, v, slot == 5u),
+                  select(k.p6, v, slot == 6u), select(k.p7, v, slot == 7u));
+}
+
+fn kept_plane(k: Planes, slot: u32) -> vec4<f32> {
+    var v = k.p0;
+    v = select(v, k.p1, slot == 1u);
+    v = select(v, k.p2, slot == 2u);
+    v = select(v, k.p3, slot == 3u);
+    v = select(v, k.p4, slot == 4u);
+    v = select(v, k.p5, slot == 5u);
+    v = select(v, k.p6, slot == 6u);
+    return select(v, k.p7, slot == 7u);
+}
+
+fn edges_inside(a: ptr<function, Outline>, b: ptr<function, Outline>, h: vec2<i32>,
+                run: bool) -> Inside {
     var r = Inside(0u, 0u, vec2<u32>(0u), vec2<u32>(0u), 0u, vec2<f32>(0.0), vec2<f32>(0.0), 0.0);
-    let na = (*a).n;
-    let nb = (*b).n;
+    let na = select(0u, (*a).n, run);
+    let nb = select(0u, (*b).n, run);
     // Only the edges of a within b's circle can reach into b, and they are found by
     // b's half-planes whose lines pass near them: the others hold them all (or none,
     // and then nothing overlaps). So a few edges are cut by a few half-planes, and
@@ -317,43 +368,53 @@ fn edges_inside(a: ptr<function, Outline>, b: ptr<function, Outline>, h: vec2<i3
     let cb = centre_at(b, h);
     let rb = (*b).reach * (1.0 + 1.0e-5);
     var edges = 0u;
-    var mean = vec2<f32>(0.0);
+    var lo = vec2<f32>(3.0e38);
+    var hi = vec2<f32>(-3.0e38);
+    let a0 = corner_at(a, 0u, h);
+    var x = a0;
     for (var e = 0u; e < na; e++) {
-        let x = corner_at(a, e, h);
-        let d = corner_at(a, next_corner(a, e), h) - x;
+        var y = a0;
+        if (e + 1u < na) { y = corner_at(a, e + 1u, h); }
+        let d = y - x;
         let t = clamp(dot(cb - x, d) / max(dot(d, d), 1.0e-30), 0.0, 1.0);
         let off = x + t * d - cb;
         if (dot(off, off) <= rb * rb) {
             edges |= 1u << e;
-            mean += x + 0.5 * d;
+            lo = min(lo, min(x, y));
+            hi = max(hi, max(x, y));
         }
+        x = y;
     }
     if (edges == 0u) { return r; }
-    // A circle holding those edges, with room for f32 rounding (1e-4 relative, 1e-5
-    // of the polygon): a half-plane that holds all of it leaves every point of them
-    // inside, exactly as cutting by it would.
-    let c = mean / f32(countOneBits(edges));
-    var rho2 = 0.0;
-    var left = edges;
-    while (left != 0u) {
-        let e = firstTrailingBit(left);
-        left &= left - 1u;
-        let x = corner_at(a, e, h) - c;
-        let y = corner_at(a, next_corner(a, e), h) - c;
-        rho2 = max(rho2, max(dot(x, x), dot(y, y)));
-    }
-    let rho = sqrt(rho2) * (1.0 + 1.0e-4) + 1.0e-5 * (*a).reach;
+    // A circle holding those edges (about their bounding box), with room for f32
+    // rounding (1e-4 relative, 1e-5 of the polygon): a half-plane that holds all of it
+    // leaves every point of them inside, exactly as cutting by it would.
+    let c = 0.5 * (lo + hi);
+    let rho = 0.5 * length(hi - lo) * (1.0 + 1.0e-4) + 1.0e-5 * (*a).reach;
+    // Those half-planes, the first eight kept in registers: each corner read is a load
+    // of its own (lane by lane on a software adapter), and the cut below reads each
+    // half-plane once per edge.
     var planes = 0u;
+    var kept = Planes(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0),
+                      vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
+    var n_kept = 0u;
+    let b0 = corner_at(b, 0u, h);
+    var ba = b0;
     for (var f = 0u; f < nb; f++) {
-        let ba = corner_at(b, f, h);
-        let bb = corner_at(b, next_corner(b, f), h);
+        var bb = b0;
+        if (f + 1u < nb) { bb = corner_at(b, f + 1u, h); }
         let m = vec2<f32>(-(bb.y - ba.y), bb.x - ba.x);
         let side = dot(c - ba, m);
         let reach = rho * length(m);
         if (side <= -reach) { return r; }
-        if (side < reach) { planes |= 1u << f; }
+        if (side < reach) {
+            planes |= 1u << f;
+            kept = keep_plane(kept, n_kept, vec4<f32>(ba, m));
+            n_kept++;
+        }
+        ba = bb;
     }
-    left = edges;
+    var left = edges;
     while (left != 0u) {
         let e = firstTrailingBit(left);
         left &= left - 1u;
@@ -368,14 +429,20 @@ fn edges_inside(a: ptr<function, Outline>, b: ptr<function, Outline>, h: vec2<i3
         var x_in = true;
         var empty = false;
         var cutting = planes;
+        var k = 0u;
         while (cutting != 0u) {
             let f = firstTrailingBit(cutting);
             cutting &= cutting - 1u;
-            let ba = corner_at(b, f, h);
-            let bb = corner_at(b, next_corner(b, f), h);
-            let m = vec2<f32>(-(bb.y - ba.y), bb.x - ba.x);
-            let dx = dot(x - ba, m);
-            let dy = dot(y - ba, m);
+            var pl = kept_plane(kept, k);
+            if (k >= 8u) {
+                let fa = corner_at(b, f, h);
+                let fb = corner_at(b, next_corner(b, f), h);
+                pl = vec4<f32>(fa, -(fb.y - fa.y), fb.x - fa.x);
+            }
+            k++;
+            let m = pl.zw;
+            let dx = dot(x - pl.xy, m);
+            let dy = dot(y - pl.xy, m);
             x_in = x_in && dx >= 0.0;
             if (dx < 0.0 && dy < 0.0) { empty = true; }
             let s = dx / (dx - dy);
@@ -491,19 +558,42 @@ fn pieces_area(a: ptr<function, Outline>, ins: Inside, a_is_p: bool, fr: Frame,
 // coordinates: f32 units relative to the frame point h. Area in units^2.
 fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2<i32>,
                    ci: vec2<f32>, cj: vec2<f32>) -> AreaContact {
-    let in_p = edges_inside(p, q, h);
-    if (in_p.pieces == 0u) { return no_contact(); }
-    let in_q = edges_inside(q, p, h);
-    let n_p = countOneBits(in_p.corners);
-    let n_q = countOneBits(in_q.corners);
+    let in_p = edges_inside(p, q, h, true);
     let n_x = countOneBits(in_p.cross);
-    if (n_p + n_q + n_x < 3u) { return no_contact(); }
-    var r2 = 0.0;
-    for (var k = 0u; k < (*p).n; k++) {
-        let x = corner_at(p, k, h) - ci;
-        r2 = max(r2, dot(x, x));
+    // Two crossings, p entering q at one and leaving it at the other (polygons resting
+    // on each other): q's part of the overlap's outline is the chain of q's edges from
+    // where p leaves q to where it enters it again, and q's own cut is not needed. Nor
+    // is it when p lies inside q (no crossing, p's edges inside). Otherwise it is: more
+    // crossings, or none and q inside p (or no overlap).
+    let entries = in_p.cross & 0x55555555u;
+    let exits = in_p.cross & 0xAAAAAAAAu;
+    let chained = countOneBits(entries) == 1u && countOneBits(exits) == 1u;
+    let p_inside = n_x == 0u && in_p.pieces != 0u;
+    let in_q = edges_inside(q, p, h, !chained && !p_inside);
+    if (in_p.pieces == 0u && in_q.pieces == 0u) { return no_contact(); }
+    // The chain: q's corners g_out + 1 ... g_in, from the crossing out of q (on q's edge
+    // g_out) to the one into it (on q's edge g_in); on one edge, none, or all of q's if
+    // the crossings follow each other the other way round it.
+    let k_in = firstTrailingBit(entries);
+    let k_out = firstTrailingBit(exits);
+    let g_in = crossing_edges(in_p, k_in).y;
+    let g_out = crossing_edges(in_p, k_out).y;
+    let nq = (*q).n;
+    var links = select(0u, (g_in + nq - g_out) % nq, chained);
+    if (chained && g_in == g_out) {
+        let along_q = corner_at(q, next_corner(q, g_in), h) - corner_at(q, g_in, h);
+        let out_to_in = crossing_at(p, q, in_p, k_in, h) - crossing_at(p, q, in_p, k_out, h);
+        if (dot(out_to_in, along_q) < 0.0) { links = nq; }
     }
-    let scale = length(cj - ci) + sqrt(r2);
+    var chain_sum = vec2<f32>(0.0);
+    for (var k = 0u; k < links; k++) {
+        chain_sum += corner_at(q, (g_out + 1u + k) % nq, h);
+    }
+    let n_p = countOneBits(in_p.corners);
+    let n_q = select(countOneBits(in_q.corners), links, chained);
+    let q_sum = select(in_q.sum, chain_sum, chained);
+    if (n_p + n_q + n_x < 3u) { return no_contact(); }
+    let scale = length(cj - ci) + (*p).reach;
     // The two crossings farthest apart (src/overlap.rs `farthest_pair`).
     var best = -1.0;
     var xa = vec2<f32>(0.0);
@@ -540,13 +630,13 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
         nn = vec2<f32>(-t.y, t.x);
         s = 0.5 * (xa + xb);
         // Corners of i inside j lie on j's side of the line, corners of j on i's side.
-        let side = dot(nn, in_p.sum - f32(n_p) * s) - dot(nn, in_q.sum - f32(n_q) * s);
+        let side = dot(nn, in_p.sum - f32(n_p) * s) - dot(nn, q_sum - f32(n_q) * s);
         if (side > 0.0 || (side == 0.0 && dot(nn, ci - cj) < 0.0)) { nn = -nn; }
         fr = make_frame(h, s, nn);
     } else {
         // Fewer than two crossings or a vanishing chord: n along the centres, S at the
         // mean of the overlap's corners.
-        g.point = (in_p.sum + in_q.sum + in_p.cross_sum) / f32(n_p + n_q + n_x);
+        g.point = (in_p.sum + q_sum + in_p.cross_sum) / f32(n_p + n_q + n_x);
         fr = make_frame(h, g.point, nn);
     }
     let c = crossings_uw(p, q, in_p, fr);
@@ -575,7 +665,21 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
         g.chord = 0.0;
     }
     let from_p = pieces_area(p, in_p, true, fr, c);
-    let from_q = pieces_area(q, in_q, false, fr, c);
+    var from_q = pieces_area(q, in_q, false, fr, c);
+    if (chained) {
+        // The chain's trapezoids, from the crossing out of q to the one into it.
+        let x_out = crossing_of(c, k_out);
+        let x_in = crossing_of(c, k_in);
+        var prev = x_out.xy;
+        var a = 0.0;
+        for (var k = 0u; k < links; k++) {
+            let x = corner_uw(q, (g_out + 1u + k) % nq, fr);
+            a += (prev.y + x.y) * (prev.x - x.x);
+            prev = x;
+        }
+        a += (prev.y + x_in.y) * (prev.x - x_in.x);
+        from_q = vec2<f32>(0.5 * a, 2.0 - x_out.z - x_in.z);
+    }
     g.area = from_p.x + from_q.x;
     if (from_p.y + from_q.y > 0.0) {
         // More than four crossings: a deep overlap, whose f32 area is good enough.
