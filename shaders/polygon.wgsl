@@ -1,10 +1,12 @@
 // Overlap-area geometry of convex polygons (src/overlap.rs, SPEC 2.3). Two polygons:
 // each one's edges cut to the part inside the other (`edges_inside`), whose ends are
-// corners or crossings of the outlines (`polygon_polygon`); a polygon and a wall: p
-// clipped by the wall's line and the lines across its ends (Sutherland-Hodgman,
-// remembering for each corner of the overlap the line its outgoing edge lies on). The
+// corners or crossings of the outlines (`polygon_polygon`); a polygon and a wall: p's
+// edges cut by the wall's line and the lines across its ends (`polygon_wall`). The
 // line through the two crossings farthest apart gives the normal, its midpoint the
-// force point.
+// force point. src/overlap.rs clips instead (Sutherland-Hodgman, a list of the overlap's
+// corners tagged by origin): the same corners, crossings and area by another route,
+// since a per-thread list is local memory on a GPU (ARCHITECTURE.md, "Polygons on the
+// GPU").
 //
 // Precision (SPEC 3; README "Precision"). Corners are whole position units in a frame
 // at particle j's centre (exact: the fixed-point offset and corners rotated in integers,
@@ -19,23 +21,18 @@
 // A = 1/2 sum (w_s + w_e)(u_s - u_e) over the boundary's pieces needs the coordinates u
 // along the line only to f32. A/l is then right to ~1e-9 d however thin the overlap.
 
-const MAX_CLIP: u32 = 36u;
-
-// Set when the pipelines are built for a polygon scene (src/gpu/kernels.rs). Disk
-// scenes compile without the polygon branches, whose large per-thread arrays would
-// otherwise cost every disk contact registers and memory.
+// Set when the pipelines are built for the overlap-area law (src/gpu/kernels.rs). The
+// other laws compile without the polygon branches, which would otherwise cost every
+// disk contact registers.
 override POLYGONS: bool = false;
-// Which shapes the scene has, now or from its sources (src/gpu/kernels.rs `Shapes`), and
+// Corners of a polygon at most (src/shape.rs). The cut keeps a bit per edge and two per
+// crossing in a u32 and an edge's number in four bits: at most 16.
+const MAX_CORNERS: u32 = 16u;
+// Which shapes the scene has, now or from its sources (src/gpu/kernels.rs `Build`), and
 // whether it has walls: the pipelines leave out the contact branches of the others.
 override POLYGON_SHAPES: bool = true;
 override DISK_SHAPES: bool = true;
 override WALLS: bool = true;
-// Line ids: edge m of p (corner m to m + 1) is m, edge m of q is Q_LINE + m; then a
-// wall's line and the lines across its two ends.
-const Q_LINE: u32 = 16u;
-const WALL_LINE: u32 = 32u;
-const END_A_LINE: u32 = 33u;
-const END_B_LINE: u32 = 34u;
 
 struct AreaContact {
     area: f32,
@@ -114,68 +111,11 @@ fn corner_at(o: ptr<function, Outline>, m: u32, h: vec2<i32>) -> vec2<f32> {
     return at_of(o, corner_rel(o, m), h);
 }
 
-// The polygon being clipped: corners and the line of each corner's outgoing edge, in
-// two buffers that alternate.
-struct Clip {
-    v: array<array<vec2<f32>, MAX_CLIP>, 2>,
-    line: array<array<u32, MAX_CLIP>, 2>,
-};
-
-// The clipped polygon's area about its first corner (a fan of triangles from it, not
-// the frame's origin: issue 18), and its extent, the largest distance of a corner from
-// the first. The f32 area is off by about extent x the clip coordinates' rounding.
-fn shoelace(c: ptr<function, Clip>, b: u32, n: u32) -> vec2<f32> {
-    let o = (*c).v[b][0];
-    var a = 0.0;
-    var extent = 0.0;
-    for (var k = 1u; k + 1u < n; k++) {
-        let p = (*c).v[b][k] - o;
-        let q = (*c).v[b][k + 1u] - o;
-        a += p.x * q.y - q.x * p.y;
-        extent = max(extent, length(q));
-    }
-    if (n > 1u) { extent = max(extent, length((*c).v[b][1] - o)); }
-    return vec2<f32>(0.5 * a, extent);
-}
-
-// Mean of the corners: the fallback force point. Unlike the area centroid it needs no
-// division by a vanishing area, so a degenerate overlap keeps S inside it.
-fn corner_mean(c: ptr<function, Clip>, b: u32, n: u32) -> vec2<f32> {
-    var s = vec2<f32>(0.0);
-    for (var k = 0u; k < n; k++) { s += (*c).v[b][k]; }
-    return s / f32(n);
-}
-
 fn reduced_arm(li: f32, lj: f32, scale: f32) -> f32 {
     let floor = 1.0e-6 * scale;
     let a = max(li, floor);
     let b = max(lj, floor);
     return a * b / (a + b);
-}
-
-// Clips polygon src (n corners) by the half-plane (x - a).m >= 0 into 1 - src; the
-// clip line has id `id`. Leaving the half-plane the outline follows the clip line,
-// entering it the edge.
-fn clip_lines(c: ptr<function, Clip>, src: u32, n: u32, a: vec2<f32>, m: vec2<f32>, id: u32) -> u32 {
-    let dst = 1u - src;
-    var out = 0u;
-    for (var e = 0u; e < n; e++) {
-        let x = (*c).v[src][e];
-        let y = (*c).v[src][(e + 1u) % n];
-        let dx = dot(x - a, m);
-        let dy = dot(y - a, m);
-        if (dx >= 0.0 && out < MAX_CLIP) {
-            (*c).v[dst][out] = x;
-            (*c).line[dst][out] = (*c).line[src][e];
-            out++;
-        }
-        if ((dx >= 0.0) != (dy >= 0.0) && out < MAX_CLIP) {
-            (*c).v[dst][out] = x + (dx / (dx - dy)) * (y - x);
-            (*c).line[dst][out] = select((*c).line[src][e], id, dx >= 0.0);
-            out++;
-        }
-    }
-    return out;
 }
 
 // --- exact distances from the contact line ---
@@ -311,8 +251,8 @@ fn nibble(v: vec2<u32>, e: u32) -> u32 {
     return (select(v.y, v.x, e < 8u) >> (4u * (e & 7u))) & 15u;
 }
 
-// Where the edge x-y crosses the line of b's edge f (x + s (y - x), the clip's f32
-// parameter: as `clip_lines` cuts an edge).
+// Where the edge x-y crosses the line of b's edge f (x + s (y - x), the f32 parameter
+// of the cut in `edges_inside`).
 fn edge_cut(x: vec2<f32>, y: vec2<f32>, b: ptr<function, Outline>, f: u32, h: vec2<i32>) -> f32 {
     let ba = corner_at(b, f, h);
     let bb = corner_at(b, next_corner(b, f), h);
@@ -690,12 +630,15 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
     return g;
 }
 
-// Area contact of polygon p (centre at the origin, clip coordinates in units) with the
-// wall segment wa-wb whose line is `l` (geometry.wgsl `wall_line`): the part of p beyond
-// the wall's line and between its end points. The f32 clip finds which lines bound it;
-// the area is then recomputed exactly, as for two polygons: w is a corner's exact
-// distance from the wall's line (zero on it, interpolated along p's edge where an edge
-// crosses an end line), u is measured from p's deepest corner by exact integer offsets.
+// Area contact of polygon p (centre at the origin, coordinates in units) with the wall
+// segment wa-wb whose line is `l` (geometry.wgsl `wall_line`): the part of p beyond the
+// wall's line and between the lines across its ends. As for two polygons, each edge of
+// p is cut to its part inside those three half-planes (f32, which only finds the
+// lines); the area is the trapezoid sum over the outline's pieces in a frame along the
+// wall, with w a point's exact distance from the wall's line and u measured along it
+// from p's deepest corner. The outline's other pieces add nothing to it:
+// on the wall's line w = 0, and the lines across the ends are perpendicular to it (u
+// stays the same along them). The chord is the stretch of the wall's line inside p.
 fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: WallLine) -> AreaContact {
     let ab = wb - wa;
     let len = length(ab);
@@ -705,108 +648,143 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: Wall
     // point can be far (its f32 offset then carries f32's precision of that distance).
     let dist = i64_to_f32(l.c64) / Q30 + l.small;
     let foot = -dist * m;
-    var c: Clip;
-    let np = (*p).n;
-    var r = 0.0;
-    var deepest = 0u;
-    for (var k = 0u; k < np; k++) {
-        c.v[0][k] = corner_at(p, k, vec2<i32>(0));
-        c.line[0][k] = k;
-        r = max(r, length(c.v[0][k]));
-        if (dot(c.v[0][k], m) < dot(c.v[0][deepest], m)) { deepest = k; }
-    }
-    var n = clip_lines(&c, 0u, np, foot, -m, WALL_LINE);
-    n = clip_lines(&c, 1u, n, wa, ab, END_A_LINE);
-    n = clip_lines(&c, 0u, n, wb, -ab, END_B_LINE);
-    if (n < 3u) { return no_contact(); }
-    // As for two polygons: the f32 area decides only outside its rounding.
-    let sh = shoelace(&c, 1u, n);
-    let margin = 1.0e-6 * sh.y * r;
-    if (sh.x <= -margin) { return no_contact(); }
-    var g = no_contact();
-    g.area = sh.x;
-    g.found = true;
-    let scale = len + r;
-    g.n = m;
-    g.point = corner_mean(&c, 1u, n);
-    g.l = max(length(g.point), 1.0e-6 * scale);
-    // The area from the lines: 1/2 sum (w_k + w_k+1)(u_k - u_k+1); the chord from the
-    // u of the corners on the wall's line.
     let t = vec2<f32>(m.y, -m.x);
+    // u from p's deepest corner: the points of a small overlap lie near it, and their
+    // u (a few units from it) keep f32's relative precision, as the chord needs.
+    let np = (*p).n;
+    var deepest = 0u;
+    var least = 3.0e38;
+    for (var k = 0u; k < np; k++) {
+        let along = dot(corner_at(p, k, vec2<i32>(0)), m);
+        if (along < least) { least = along; deepest = k; }
+    }
     let base = ow(p, deepest);
-    let first = wall_uw(p, &c, n, 0u, l, t, base);
-    var prev = first;
-    var a = 0.0;
+    let u_a = dot(wa - vec2<f32>(base), t);
+    let u_b = dot(wb - vec2<f32>(base), t);
+    // Beyond the wall's line; past end a; short of end b.
+    let zero = vec4<f32>(0.0);
+    let cuts = Planes(vec4<f32>(foot, -m), vec4<f32>(wa, ab), vec4<f32>(wb, -ab),
+                      zero, zero, zero, zero, zero);
+    let c0 = corner_rel(p, 0u);
+    var cx = c0;
+    var x = at_of(p, cx, vec2<i32>(0));
+    var xuw = vec2<f32>(corner_u_of(p, cx, base, t), corner_wall_w_of(p, cx, l));
+    var area = 0.0;
     var lo = 3.0e38;
     var hi = -3.0e38;
-    for (var e = 1u; e <= n; e++) {
-        var x = first;
-        if (e < n) { x = wall_uw(p, &c, n, e, l, t, base); }
-        a += (prev.y + x.y) * (prev.x - x.x);
-        if (x.z > 0.0) { lo = min(lo, x.x); hi = max(hi, x.x); }
-        prev = x;
+    var sum = vec2<f32>(0.0);
+    var count = 0u;
+    var a_in = true;
+    var b_in = true;
+    for (var e = 0u; e < np; e++) {
+        var cy = c0;
+        if (e + 1u < np) { cy = corner_rel(p, e + 1u); }
+        let y = at_of(p, cy, vec2<i32>(0));
+        let yuw = vec2<f32>(corner_u_of(p, cy, base, t), corner_wall_w_of(p, cy, l));
+        // The wall's ends: corners of the overlap where p holds them.
+        a_in = a_in && cross2(y - x, wa - x) >= 0.0;
+        b_in = b_in && cross2(y - x, wb - x) >= 0.0;
+        var t0 = 0.0;
+        var t1 = 1.0;
+        var fin = 0u;
+        var fout = 0u;
+        var x_in = true;
+        var empty = false;
+        for (var k = 0u; k < 3u; k++) {
+            let pl = kept_plane(cuts, k);
+            let dx = dot(x - pl.xy, pl.zw);
+            let dy = dot(y - pl.xy, pl.zw);
+            x_in = x_in && dx >= 0.0;
+            if (dx < 0.0 && dy < 0.0) { empty = true; }
+            let s = dx / (dx - dy);
+            if (dx < 0.0 && dy >= 0.0 && s > t0) { t0 = s; fin = k + 1u; }
+            if (dx >= 0.0 && dy < 0.0 && s < t1) { t1 = s; fout = k + 1u; }
+        }
+        if (x_in) {
+            sum += x;
+            count++;
+        }
+        if (!empty && t0 < t1) {
+            // Across the wall's line: at the exact parameter from the ends' w; across an
+            // end's line: the end's u, w along p's edge from its nearer end.
+            let on_wall = crossing_param(xuw.y, yuw.y);
+            var s_uw = xuw;
+            if (fin == 1u) {
+                s_uw = vec2<f32>(interpolate_w(xuw.x, yuw.x, on_wall).x, 0.0);
+                lo = min(lo, s_uw.x);
+                hi = max(hi, s_uw.x);
+            }
+            if (fin >= 2u) {
+                s_uw = vec2<f32>(select(u_b, u_a, fin == 2u),
+                                 interpolate_w(xuw.y, yuw.y, vec2<f32>(t0, 1.0 - t0)).x);
+            }
+            var e_uw = yuw;
+            if (fout == 1u) {
+                e_uw = vec2<f32>(interpolate_w(xuw.x, yuw.x, on_wall).x, 0.0);
+                lo = min(lo, e_uw.x);
+                hi = max(hi, e_uw.x);
+            }
+            if (fout >= 2u) {
+                e_uw = vec2<f32>(select(u_b, u_a, fout == 2u),
+                                 interpolate_w(xuw.y, yuw.y, vec2<f32>(t1, 1.0 - t1)).x);
+            }
+            area += (s_uw.y + e_uw.y) * (s_uw.x - e_uw.x);
+            // The overlap's corners where p's outline crosses into it and out of it.
+            if (fin > 0u) {
+                sum += x + t0 * (y - x);
+                count++;
+            }
+            if (fout > 0u) {
+                sum += x + t1 * (y - x);
+                count++;
+            }
+        }
+        cx = cy;
+        x = y;
+        xuw = yuw;
     }
-    g.area = 0.5 * a;
+    if (a_in) {
+        sum += wa;
+        count++;
+        lo = min(lo, u_a);
+        hi = max(hi, u_a);
+    }
+    if (b_in) {
+        sum += wb;
+        count++;
+        lo = min(lo, u_b);
+        hi = max(hi, u_b);
+    }
+    if (count < 3u || area <= 0.0) { return no_contact(); }
+    let scale = len + (*p).reach;
+    var g = no_contact();
+    g.found = true;
+    g.area = 0.5 * area;
+    g.n = m;
+    g.point = sum / f32(count);
+    g.l = max(length(g.point), 1.0e-6 * scale);
     if (hi > lo) {
         g.chord = hi - lo;
         // On the wall's line: at the foot of the centre moved along t.
         g.point = (0.5 * (lo + hi) + dot(vec2<f32>(base), t)) * t - dist * m;
         g.l = max(length(g.point), 1.0e-6 * scale);
     }
-    if (g.area <= 0.0) { return no_contact(); }
     return g;
 }
 
-// (u, w, on the wall's line) of corner e of the clipped polygon (buffer 1): u along t
-// from the integer point `base` near the contact, w the distance from the wall's line.
-fn wall_uw(p: ptr<function, Outline>, c: ptr<function, Clip>, n: u32, e: u32, l: WallLine,
-           t: vec2<f32>, base: vec2<i32>) -> vec3<f32> {
-    let lin = (*c).line[1][(e + n - 1u) % n];
-    let lout = (*c).line[1][e];
-    let np = (*p).n;
-    let at = (*c).v[1][e];
-    let u_at = dot(at - vec2<f32>(base), t);
-    var edge = lout;
-    if (lin < Q_LINE) { edge = lin; }
-    if (lin == WALL_LINE || lout == WALL_LINE) {
-        if (edge < Q_LINE) {
-            // An edge of p across the wall's line, at the exact parameter.
-            let y = (edge + 1u) % np;
-            let s = crossing_param(corner_wall_w(p, edge, l), corner_wall_w(p, y, l));
-            let u = interpolate_w(corner_u(p, edge, base, t), corner_u(p, y, base, t), s).x;
-            return vec3<f32>(u, 0.0, 1.0);
-        }
-        return vec3<f32>(u_at, 0.0, 1.0);   // an end point of the wall
-    }
-    if (lin < Q_LINE && lout < Q_LINE && lout == (lin + 1u) % np) {
-        return vec3<f32>(corner_u(p, lout, base, t), corner_wall_w(p, lout, l), 0.0);
-    }
-    if (edge < Q_LINE) {
-        // An edge of p across an end line: along the edge, from its nearer end.
-        let y = (edge + 1u) % np;
-        let xf = corner_at(p, edge, vec2<i32>(0));
-        let d = corner_at(p, y, vec2<i32>(0)) - xf;
-        let s = clamp(dot(at - xf, d) / max(dot(d, d), 1.0e-30), 0.0, 1.0);
-        let w = interpolate_w(corner_wall_w(p, edge, l), corner_wall_w(p, y, l),
-                              vec2<f32>(s, 1.0 - s)).x;
-        return vec3<f32>(u_at, w, 0.0);
-    }
-    // A wall end inside p, between two end or wall lines: f32.
-    return vec3<f32>(u_at, dot(at, l.n) + i64_to_f32(l.c64) / Q30 + l.small, 0.0);
+// Along t from the integer point `base` of the corner read as c (exact offset, one
+// rounding).
+fn corner_u_of(p: ptr<function, Outline>, c: vec2<i32>, base: vec2<i32>, t: vec2<f32>) -> f32 {
+    return dot(vec2<f32>((*p).base + c - base) + e_of(p, c), t);
 }
 
-// Corner m along t from the integer point `base` (exact offset, one rounding).
-fn corner_u(p: ptr<function, Outline>, m: u32, base: vec2<i32>, t: vec2<f32>) -> f32 {
-    return dot(vec2<f32>(ow(p, m) - base) + corner_e(p, m), t);
-}
-
-// Corner m's distance from the wall's line (units, positive on the centre's side): the
-// centre's exact (c - a).q plus the corner's w.q in 64-bit integers, and the small
-// parts (remainders, the turn beta of q).
-fn corner_wall_w(p: ptr<function, Outline>, m: u32, l: WallLine) -> f32 {
-    let w = ow(p, m);
+// The distance from the wall's line (units, positive on the centre's side) of the
+// corner read as c: the centre's exact (c - a).q plus the corner's w.q in 64-bit
+// integers, and the small parts (remainders, the turn beta of q).
+fn corner_wall_w_of(p: ptr<function, Outline>, c: vec2<i32>, l: WallLine) -> f32 {
+    let w = (*p).base + c;
     let exact = add64(l.c64, add64(smul(w.x, l.q.x), smul(w.y, l.q.y)));
-    return i64_to_f32(exact) / Q30 + l.small + dot(corner_e(p, m), l.n)
+    return i64_to_f32(exact) / Q30 + l.small + dot(e_of(p, c), l.n)
         - l.beta * dot(vec2<f32>(w), l.t) - l.alpha * dot(vec2<f32>(w), l.n);
 }
 

@@ -134,15 +134,11 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("HALT_CONTACTS_FULL", c::HALT_CONTACTS_FULL as f64),
         ("HALT_TABLE_FULL", c::HALT_TABLE_FULL as f64),
         ("MAX_WORKGROUPS", talus::gpu::MAX_WORKGROUPS as f64),
-        ("MAX_CLIP", talus::overlap::MAX_CLIP as f64),
-        ("Q_LINE", talus::overlap::Q_LINE as f64),
-        ("WALL_LINE", talus::overlap::WALL_LINE as f64),
-        ("END_A_LINE", talus::overlap::END_A_LINE as f64),
-        ("END_B_LINE", talus::overlap::END_B_LINE as f64),
         ("HASH_X", talus::gpu::HASH_X as f64),
         ("HASH_Z", talus::gpu::HASH_Z as f64),
         ("HASH_MIX_1", talus::gpu::HASH_MIX_1 as f64),
         ("HASH_MIX_2", talus::gpu::HASH_MIX_2 as f64),
+        ("MAX_CORNERS", talus::shape::MAX_CORNERS as f64),
     ];
     for (name, value) in rust {
         match wgsl.get(*name) {
@@ -150,8 +146,12 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
             None => panic!("{name} is not a constant of the WGSL"),
         }
     }
-    // The polygon kernels' line ids and clip sizes follow from the corner limit.
-    assert_eq!(talus::overlap::Q_LINE, talus::shape::MAX_CORNERS);
+    // polygon.wgsl keeps a bit per edge and two per crossing of a polygon in a u32, and
+    // an edge's number in four bits.
+    assert!(
+        talus::shape::MAX_CORNERS <= 16,
+        "polygon.wgsl's masks hold 16 corners"
+    );
 }
 
 #[test]
