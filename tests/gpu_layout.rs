@@ -34,6 +34,33 @@ fn every_kernel_module_validates() {
 }
 
 #[test]
+fn every_binding_is_the_one_rust_binds() {
+    // src/gpu/buffers.rs `BINDINGS` is the one list the bind groups are built from: every
+    // variable the WGSL declares with a binding is in it, at the same group and binding,
+    // and nothing else is (the plan module declares group 2 besides common.wgsl's).
+    let src = MODULES.iter().find(|m| m.name == "plan").unwrap().source();
+    let module = parse("plan", &src);
+    let mut wgsl: Vec<(String, u32, u32)> = module
+        .global_variables
+        .iter()
+        .filter_map(|(_, v)| {
+            let b = v.binding.as_ref()?;
+            Some((v.name.clone().unwrap_or_default(), b.group, b.binding))
+        })
+        .collect();
+    let mut rust: Vec<(String, u32, u32)> = talus::gpu::BINDINGS
+        .iter()
+        .map(|b| (b.name.to_string(), b.group, b.binding))
+        .collect();
+    wgsl.sort_by_key(|b| (b.1, b.2));
+    rust.sort_by_key(|b| (b.1, b.2));
+    assert_eq!(
+        wgsl, rust,
+        "the WGSL's bindings against src/gpu/buffers.rs BINDINGS"
+    );
+}
+
+#[test]
 fn rust_layouts_match_wgsl() {
     // common.wgsl declares every shared struct; the force module includes it.
     let src = MODULES

@@ -285,9 +285,9 @@ impl Kernel {
 /// table) and of group 2 (the indirect dispatch arguments, bound only to
 /// `plan_rebuild`: a buffer cannot be an indirect argument and writable storage in one
 /// dispatch).
-pub const GROUP0_STORAGE: u32 = 27;
-pub const GROUP1_STORAGE: u32 = 1;
-pub const GROUP2_STORAGE: u32 = 1;
+pub const GROUP0_STORAGE: u32 = super::buffers::storage_bindings(0);
+pub const GROUP1_STORAGE: u32 = super::buffers::storage_bindings(1);
+pub const GROUP2_STORAGE: u32 = super::buffers::storage_bindings(2);
 
 fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {

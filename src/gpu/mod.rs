@@ -23,6 +23,7 @@
 
 mod buckets;
 mod buffers;
+pub use buffers::{BINDINGS, Binding};
 pub mod device;
 mod insert;
 pub mod kernels;

@@ -473,33 +473,21 @@ impl GpuSimulation {
         self.write_buffer(&buf, counts);
     }
 
-    /// Reads a named per-step buffer as u32 words (tests).
+    /// Reads a buffer, by the name of its WGSL variable, as u32 words (tests).
     pub fn read_u32(&self, name: &str, count: usize) -> Vec<u32> {
-        let b = &self.buffers;
-        let buf = match name {
-            "cell_of" => &b.cell_of,
-            "cell_count" => &b.cell_count,
-            "cell_start" => &b.cell_start,
-            "sorted" => &b.sorted,
-            "ids" => &b.ids,
-            "contact_j" => &b.contact_j,
-            "contact_count" => &b.contact_count,
-            "touching" => &b.touching,
-            "table" => &b.table,
-            "control" => &b.control,
-            "dispatch_args" => &b.dispatch_args,
-            "pairs" => &b.pairs,
-            _ => panic!("unknown buffer {name}"),
-        };
+        let buf = self
+            .buffers
+            .named(name)
+            .unwrap_or_else(|| panic!("unknown buffer {name}"));
         self.read_buffer(buf, 0, count)
     }
 
+    /// Reads a buffer, by the name of its WGSL variable, as f32 words (tests).
     pub fn read_f32(&self, name: &str, count: usize) -> Vec<f32> {
-        let b = &self.buffers;
-        let buf = match name {
-            "hist_in" => &b.hist_in,
-            _ => panic!("unknown buffer {name}"),
-        };
+        let buf = self
+            .buffers
+            .named(name)
+            .unwrap_or_else(|| panic!("unknown buffer {name}"));
         self.read_buffer(buf, 0, count)
     }
 
