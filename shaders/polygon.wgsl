@@ -983,6 +983,20 @@ fn circle_reach(x: vec2<f32>, u: vec2<f32>, depth: f32, r: f32) -> f32 {
     return root - b;
 }
 
+// Where edge m of p crosses the circle of radius r about the origin: the k-th crossing
+// along the edge (xy) and whether there is one (z).
+fn circle_crossing(p: ptr<function, Outline>, m: u32, k: u32, r: f32) -> vec3<f32> {
+    let a = corner_at(p, m, vec2<i32>(0));
+    let d = corner_at(p, next_corner(p, m), vec2<i32>(0)) - a;
+    let qa = dot(d, d);
+    let qb = 2.0 * dot(a, d);
+    let disc = qb * qb - 4.0 * qa * (dot(a, a) - r * r);
+    if (qa <= 0.0 || disc < 0.0) { return vec3<f32>(0.0); }
+    let t = (-qb + select(-sqrt(disc), sqrt(disc), k == 1u)) / (2.0 * qa);
+    if (t < 0.0 || t >= 1.0) { return vec3<f32>(0.0); }
+    return vec3<f32>(a + t * d, 1.0);
+}
+
 // Area contact of polygon `poly` and disk `disk` (polygon_is_i: which one is i), in
 // length units with the force point relative to centre i. Frame: the disk's centre.
 fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
@@ -1108,40 +1122,39 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
     }
     if (!done) {
         // Deep or unusual: the general formula in f32 (src/overlap.rs `polygon_disk`),
-        // the force point between the two crossings of the outlines farthest apart.
+        // the force point between the two crossings of the outlines farthest apart. The
+        // crossings are found again for each pair of edges rather than listed (a
+        // per-thread list is local memory on a GPU), in the CPU's order: by edge, then
+        // along it.
+        let edges = np;
         var area = 0.0;
-        var xs: array<vec2<f32>, 32>;
-        var nx = 0u;
-        for (var m = 0u; m < np; m++) {
+        for (var m = 0u; m < edges; m++) {
             let a = corner_at(&p, m, vec2<i32>(0));
-            let b = corner_at(&p, (m + 1u) % np, vec2<i32>(0));
+            let b = corner_at(&p, next_corner(&p, m), vec2<i32>(0));
             area += triangle_in_circle(a, b, r);
-            let d = b - a;
-            let qa = dot(d, d);
-            let qb = 2.0 * dot(a, d);
-            let disc = qb * qb - 4.0 * qa * (dot(a, a) - r * r);
-            if (qa > 0.0 && disc >= 0.0) {
-                let sq = sqrt(disc);
-                for (var k = 0u; k < 2u; k++) {
-                    let t = (-qb + select(-sq, sq, k == 1u)) / (2.0 * qa);
-                    if (t >= 0.0 && t < 1.0 && nx < 32u) { xs[nx] = a + t * d; nx++; }
-                }
-            }
         }
         if (area <= 0.0) { return no_contact(); }
         g.area = area;
         towards_disk = -cp / max(length(cp), 1.0e-30);
         if (length(cp) == 0.0) { towards_disk = vec2<f32>(0.0, -1.0); }
         var best = -1.0;
-        for (var a = 0u; a < nx; a++) {
-            for (var b = a + 1u; b < nx; b++) {
-                let d = length(xs[b] - xs[a]);
-                if (d > best) {
-                    best = d;
-                    g.point = 0.5 * (xs[a] + xs[b]);
-                    g.chord = d;
-                    let tt = (xs[b] - xs[a]) / max(d, 1.0e-30);
-                    towards_disk = vec2<f32>(-tt.y, tt.x);
+        for (var ea = 0u; ea < edges; ea++) {
+            for (var ka = 0u; ka < 2u; ka++) {
+                let xa = circle_crossing(&p, ea, ka, r);
+                if (xa.z == 0.0) { continue; }
+                for (var eb = ea; eb < edges; eb++) {
+                    for (var kb = select(0u, ka + 1u, eb == ea); kb < 2u; kb++) {
+                        let xb = circle_crossing(&p, eb, kb, r);
+                        if (xb.z == 0.0) { continue; }
+                        let d = length(xb.xy - xa.xy);
+                        if (d > best) {
+                            best = d;
+                            g.point = 0.5 * (xa.xy + xb.xy);
+                            g.chord = d;
+                            let tt = (xb.xy - xa.xy) / max(d, 1.0e-30);
+                            towards_disk = vec2<f32>(-tt.y, tt.x);
+                        }
+                    }
                 }
             }
         }
