@@ -265,6 +265,32 @@ fn edge_cut(x: vec2<f32>, y: vec2<f32>, b: ptr<function, Outline>, f: u32, h: ve
 // `run`: false skips it (every loop runs no turn: on a software adapter, which takes
 // every branch of every thread, a branch skipped costs as much as one taken, and a loop
 // of no turns costs one).
+// The part [t0, t1] of an edge x-y inside some half-planes (Cyrus-Beck): the lines it
+// enters and leaves by (their number + 1; 0: it starts at x, ends at y), whether x is
+// inside them all, and whether the edge lies wholly outside one.
+struct Cut {
+    t0: f32,
+    t1: f32,
+    fin: u32,
+    fout: u32,
+    x_in: bool,
+    empty: bool,
+};
+
+fn uncut() -> Cut {
+    return Cut(0.0, 1.0, 0u, 0u, true, false);
+}
+
+// Cuts by the half-plane (z - a).m >= 0, line number `line`, where x and y lie at dx
+// and dy (counter-clockwise outlines: inside is to the left of each edge).
+fn cut_by(c: ptr<function, Cut>, dx: f32, dy: f32, line: u32) {
+    (*c).x_in = (*c).x_in && dx >= 0.0;
+    if (dx < 0.0 && dy < 0.0) { (*c).empty = true; }
+    let s = dx / (dx - dy);
+    if (dx < 0.0 && dy >= 0.0 && s > (*c).t0) { (*c).t0 = s; (*c).fin = line + 1u; }
+    if (dx >= 0.0 && dy < 0.0 && s < (*c).t1) { (*c).t1 = s; (*c).fout = line + 1u; }
+}
+
 // Up to eight half-planes (a point of the line, xy; its inward normal, zw).
 struct Planes {
     p0: vec4<f32>,
@@ -360,14 +386,8 @@ fn edges_inside(a: ptr<function, Outline>, b: ptr<function, Outline>, h: vec2<i3
         left &= left - 1u;
         let x = corner_at(a, e, h);
         let y = corner_at(a, next_corner(a, e), h);
-        // Cyrus-Beck: the interval [t0, t1] of x-y in the half-planes (z - b_f).m_f >= 0
-        // (counter-clockwise: inside is to the left of each edge).
-        var t0 = 0.0;
-        var t1 = 1.0;
-        var fin = 0u;
-        var fout = 0u;
-        var x_in = true;
-        var empty = false;
+        // The part of x-y inside the half-planes (z - b_f).m_f >= 0 of b.
+        var cut = uncut();
         var cutting = planes;
         var k = 0u;
         while (cutting != 0u) {
@@ -380,31 +400,24 @@ fn edges_inside(a: ptr<function, Outline>, b: ptr<function, Outline>, h: vec2<i3
                 pl = vec4<f32>(fa, -(fb.y - fa.y), fb.x - fa.x);
             }
             k++;
-            let m = pl.zw;
-            let dx = dot(x - pl.xy, m);
-            let dy = dot(y - pl.xy, m);
-            x_in = x_in && dx >= 0.0;
-            if (dx < 0.0 && dy < 0.0) { empty = true; }
-            let s = dx / (dx - dy);
-            if (dx < 0.0 && dy >= 0.0 && s > t0) { t0 = s; fin = f + 1u; }
-            if (dx >= 0.0 && dy < 0.0 && s < t1) { t1 = s; fout = f + 1u; }
+            cut_by(&cut, dot(x - pl.xy, pl.zw), dot(y - pl.xy, pl.zw), f);
         }
-        if (x_in) {
+        if (cut.x_in) {
             r.corners |= 1u << e;
             r.sum += x;
         }
-        if (!empty && t0 < t1) {
+        if (!cut.empty && cut.t0 < cut.t1) {
             r.pieces |= 1u << e;
-            r.area2 += cross2(x + t0 * (y - x), x + t1 * (y - x));
-            if (fin > 0u) {
+            r.area2 += cross2(x + cut.t0 * (y - x), x + cut.t1 * (y - x));
+            if (cut.fin > 0u) {
                 r.cross |= 1u << (2u * e);
-                r.entry = put_nibble(r.entry, e, fin - 1u);
-                r.cross_sum += x + t0 * (y - x);
+                r.entry = put_nibble(r.entry, e, cut.fin - 1u);
+                r.cross_sum += x + cut.t0 * (y - x);
             }
-            if (fout > 0u) {
+            if (cut.fout > 0u) {
                 r.cross |= 2u << (2u * e);
-                r.exit = put_nibble(r.exit, e, fout - 1u);
-                r.cross_sum += x + t1 * (y - x);
+                r.exit = put_nibble(r.exit, e, cut.fout - 1u);
+                r.cross_sum += x + cut.t1 * (y - x);
             }
         }
     }
@@ -684,58 +697,41 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: Wall
         // The wall's ends: corners of the overlap where p holds them.
         a_in = a_in && cross2(y - x, wa - x) >= 0.0;
         b_in = b_in && cross2(y - x, wb - x) >= 0.0;
-        var t0 = 0.0;
-        var t1 = 1.0;
-        var fin = 0u;
-        var fout = 0u;
-        var x_in = true;
-        var empty = false;
+        var cut = uncut();
         for (var k = 0u; k < 3u; k++) {
             let pl = kept_plane(cuts, k);
-            let dx = dot(x - pl.xy, pl.zw);
-            let dy = dot(y - pl.xy, pl.zw);
-            x_in = x_in && dx >= 0.0;
-            if (dx < 0.0 && dy < 0.0) { empty = true; }
-            let s = dx / (dx - dy);
-            if (dx < 0.0 && dy >= 0.0 && s > t0) { t0 = s; fin = k + 1u; }
-            if (dx >= 0.0 && dy < 0.0 && s < t1) { t1 = s; fout = k + 1u; }
+            cut_by(&cut, dot(x - pl.xy, pl.zw), dot(y - pl.xy, pl.zw), k);
         }
-        if (x_in) {
+        if (cut.x_in) {
             sum += x;
             count++;
         }
-        if (!empty && t0 < t1) {
-            // Across the wall's line: at the exact parameter from the ends' w; across an
-            // end's line: the end's u, w along p's edge from its nearer end.
+        if (!cut.empty && cut.t0 < cut.t1) {
             let on_wall = crossing_param(xuw.y, yuw.y);
             var s_uw = xuw;
-            if (fin == 1u) {
-                s_uw = vec2<f32>(interpolate_w(xuw.x, yuw.x, on_wall).x, 0.0);
+            if (cut.fin > 0u) {
+                s_uw = wall_cut_uw(xuw, yuw, on_wall, cut.fin, cut.t0, u_a, u_b);
+            }
+            var e_uw = yuw;
+            if (cut.fout > 0u) {
+                e_uw = wall_cut_uw(xuw, yuw, on_wall, cut.fout, cut.t1, u_a, u_b);
+            }
+            if (cut.fin == 1u) {
                 lo = min(lo, s_uw.x);
                 hi = max(hi, s_uw.x);
             }
-            if (fin >= 2u) {
-                s_uw = vec2<f32>(select(u_b, u_a, fin == 2u),
-                                 interpolate_w(xuw.y, yuw.y, vec2<f32>(t0, 1.0 - t0)).x);
-            }
-            var e_uw = yuw;
-            if (fout == 1u) {
-                e_uw = vec2<f32>(interpolate_w(xuw.x, yuw.x, on_wall).x, 0.0);
+            if (cut.fout == 1u) {
                 lo = min(lo, e_uw.x);
                 hi = max(hi, e_uw.x);
             }
-            if (fout >= 2u) {
-                e_uw = vec2<f32>(select(u_b, u_a, fout == 2u),
-                                 interpolate_w(xuw.y, yuw.y, vec2<f32>(t1, 1.0 - t1)).x);
-            }
             area += (s_uw.y + e_uw.y) * (s_uw.x - e_uw.x);
             // The overlap's corners where p's outline crosses into it and out of it.
-            if (fin > 0u) {
-                sum += x + t0 * (y - x);
+            if (cut.fin > 0u) {
+                sum += x + cut.t0 * (y - x);
                 count++;
             }
-            if (fout > 0u) {
-                sum += x + t1 * (y - x);
+            if (cut.fout > 0u) {
+                sum += x + cut.t1 * (y - x);
                 count++;
             }
         }
@@ -770,6 +766,17 @@ fn polygon_wall(p: ptr<function, Outline>, wa: vec2<f32>, wb: vec2<f32>, l: Wall
         g.l = max(length(g.point), 1.0e-6 * scale);
     }
     return g;
+}
+
+// (u, w) where p's edge from x to y meets cut line `line` (1: the wall's, 2 and 3:
+// across end a and end b) at parameter t from x: on the wall's line at the exact
+// parameter from the ends' w (`on_wall`); on an end's line, the end's u and w along the
+// edge from its nearer end.
+fn wall_cut_uw(xuw: vec2<f32>, yuw: vec2<f32>, on_wall: vec2<f32>, line: u32, t: f32,
+               u_a: f32, u_b: f32) -> vec2<f32> {
+    if (line == 1u) { return vec2<f32>(interpolate_w(xuw.x, yuw.x, on_wall).x, 0.0); }
+    return vec2<f32>(select(u_b, u_a, line == 2u),
+                     interpolate_w(xuw.y, yuw.y, vec2<f32>(t, 1.0 - t)).x);
 }
 
 // Along t from the integer point `base` of the corner read as c (exact offset, one
