@@ -192,8 +192,10 @@ impl Buffers {
                     | wgpu::BufferUsages::COPY_SRC,
             }),
             pairs: {
-                // The count, then a slot per candidate.
-                zeroed("pairs", 4 + n * m * 4)
+                // The count, then a slot per candidate: only the overlap-area law takes a
+                // thread per pair (64 bytes a particle the disk laws do not need).
+                let slots = if params.law == LAW_AREA { n * m } else { 0 };
+                zeroed("pairs", 4 + slots * 4)
             },
         }
     }
