@@ -24,18 +24,29 @@ fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
 fn correct(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= live() || halted()) { return; }
-    if (is_integrated(i)) {
+    // The state is read once and written once: the boundaries, the prediction and the
+    // survey below take this copy (a software adapter reads and writes a State word by
+    // word and lane by lane).
+    var s = state[i];
+    let integrated = is_integrated(i);
+    if (integrated) {
         // Forces were evaluated at the predicted state, i.e. at time t + dt.
         let g = gravity_at(f32(atomicLoad(&control[C_STEP]) + 1u));
-        var s = state[i];
         correct_one(&s, acceleration(i, g));
         renormalize(&s);
         renormalize_turn(&s);
-        state[i] = s;
     }
     // The boundaries (boundaries.wgsl; src/sim.rs `remove_escaped`).
-    leave_domain(i);
-    // The next step's prediction and survey (predict.wgsl): one dispatch and one pass
-    // over the state less per step.
-    if (AHEAD) { predict_particle(i, AHEAD_REBUILD); }
+    leave_domain_at(i, s);
+    // The next step's prediction and survey (predict.wgsl `predict_particle`): one
+    // dispatch and one pass over the state less per step. A particle the boundaries
+    // just removed is not predicted.
+    if (AHEAD && is_integrated(i)) {
+        predict_one(&s);
+        renormalize(&s);
+        renormalize_turn(&s);
+        rotate_corners(i, s);
+    }
+    if (integrated) { state[i] = s; }
+    if (AHEAD) { survey_one_at(i, AHEAD_REBUILD, s); }
 }

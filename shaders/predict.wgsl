@@ -20,7 +20,8 @@ fn predict_one(s: ptr<function, State>) {
 }
 
 // Particle i predicted, then surveyed (`bit`: see `survey_one`). `correct` with AHEAD
-// runs it for the next step (src/sim.rs `correct_ahead`).
+// runs the same steps for the next step on its own copy of the state (src/sim.rs
+// `correct_ahead`).
 fn predict_particle(i: u32, bit: u32) {
     if (is_integrated(i)) {
         var s = state[i];

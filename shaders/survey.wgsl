@@ -21,11 +21,16 @@ fn moved(s: State) -> bool {
 // lists' bit it sets, REBUILD for this step, AHEAD_REBUILD for the next (a prediction
 // run ahead in `correct`).
 fn survey_one(i: u32, bit: u32) {
+    survey_one_at(i, bit, state[i]);
+}
+
+// `survey_one` for particle i at state s (the caller's copy, as it stores it).
+fn survey_one_at(i: u32, bit: u32, s: State) {
     if (params.skin <= 0.0) {
         if (i == 0u) { atomicOr(&control[C_LISTS], bit); }
         return;
     }
-    if (is_active(i) && moved(state[i])) { atomicOr(&control[C_LISTS], bit); }
+    if (is_active(i) && moved(s)) { atomicOr(&control[C_LISTS], bit); }
 }
 
 @compute @workgroup_size(WG)
