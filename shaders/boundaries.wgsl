@@ -4,12 +4,8 @@
 // integrators' kernels (`correct`, `kick_drift`), for each active particle once it has
 // moved: one dispatch fewer per step.
 
-fn leave_domain(i: u32) {
-    leave_domain_at(i, state[i]);
-}
-
-// `leave_domain` for particle i at state s (the caller's copy, as it will store it).
-fn leave_domain_at(i: u32, s: State) {
+// Particle i at state s (the integrator's copy, as it will store it).
+fn leave_domain(i: u32, s: State) {
     if (!is_active(i)) { return; }
     let p = position(s);
     let ok = abs(s.q[0].x) <= 3.0e38 && abs(s.q[0].y) <= 3.0e38 && abs(s.q[0].z) <= 3.0e38;

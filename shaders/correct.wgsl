@@ -37,7 +37,7 @@ fn correct(@builtin(global_invocation_id) gid: vec3<u32>) {
         renormalize_turn(&s);
     }
     // The boundaries (boundaries.wgsl; src/sim.rs `remove_escaped`).
-    leave_domain_at(i, s);
+    leave_domain(i, s);
     // The next step's prediction and survey (predict.wgsl `predict_particle`): one
     // dispatch and one pass over the state less per step. A particle the boundaries
     // just removed is not predicted.

@@ -6,9 +6,10 @@
 fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= live() || halted()) { return; }
+    // Read once: the boundaries take this copy.
+    var s = state[i];
     if (is_integrated(i)) {
         let g = gravity_at(f32(atomicLoad(&control[C_STEP])));
-        var s = state[i];
         let a = acceleration(i, g);
         s.q[1] += a * params.dt * params.dt;
         renormalize_q1(&s);
@@ -21,5 +22,5 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
         rotate_corners(i, s);
     }
     // The boundaries (boundaries.wgsl; src/sim.rs `remove_escaped`).
-    leave_domain(i);
+    leave_domain(i, s);
 }

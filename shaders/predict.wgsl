@@ -23,8 +23,8 @@ fn predict_one(s: ptr<function, State>) {
 // runs the same steps for the next step on its own copy of the state (src/sim.rs
 // `correct_ahead`).
 fn predict_particle(i: u32, bit: u32) {
+    var s = state[i];
     if (is_integrated(i)) {
-        var s = state[i];
         predict_one(&s);
         renormalize(&s);
         renormalize_turn(&s);
@@ -32,8 +32,9 @@ fn predict_particle(i: u32, bit: u32) {
         // Forces are evaluated at the predicted state.
         rotate_corners(i, s);
     }
-    // The survey of the predicted particle (survey.wgsl; src/sim.rs `survey_with`).
-    survey_one(i, bit);
+    // The survey of the predicted particle (survey.wgsl; src/sim.rs `survey_with`), on
+    // the copy just written.
+    survey_one_at(i, bit, s);
 }
 
 @compute @workgroup_size(WG)
