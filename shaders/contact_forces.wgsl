@@ -56,22 +56,24 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>,
         let total = atomicLoad(&pairs.count);
         for (var t = gid.x; t < total; t += groups.x * WG) {
             let slot = pairs.slot[t];
-            candidate_force(slot / MAX_CONTACTS, slot);
+            let i = slot / MAX_CONTACTS;
+            candidate_force(i, slot, props[i].radius, props[i].mass, velocity(i));
         }
         return;
     }
     let i = gid.x;
     if (i >= live()) { return; }
-    for (var k = 0u; k < contact_count[i]; k++) {
-        candidate_force(i, i * MAX_CONTACTS + k);
-    }
-}
-
-// Candidate `slot` of particle i's list.
-fn candidate_force(i: u32, slot: u32) {
+    // Particle i's own values once for all its candidates.
     let ri = props[i].radius;
     let m1 = props[i].mass;
     let v1 = velocity(i);
+    for (var k = 0u; k < contact_count[i]; k++) {
+        candidate_force(i, i * MAX_CONTACTS + k, ri, m1, v1);
+    }
+}
+
+// Candidate `slot` of particle i's list; i's radius, mass and velocity.
+fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
     let j = contact_j[slot];
     let wall = j >= WALL_BASE;
     var g: Geometry;
