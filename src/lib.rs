@@ -23,6 +23,7 @@ pub mod law;
 pub mod neighbours;
 pub mod overlap;
 pub mod parallel;
+pub mod team;
 pub mod progress;
 pub mod render;
 pub mod reproduce;

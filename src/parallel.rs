@@ -10,23 +10,52 @@
 
 use rayon::prelude::*;
 
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Below this many items a stage runs on the calling thread (1024 unless a test lowers
 /// it to run small scenes on every thread).
 static MIN_PARALLEL: AtomicUsize = AtomicUsize::new(1024);
-/// Items per task: at most 512, fewer for a small stage so that every thread gets some.
-fn chunk(n: usize) -> usize {
-    (n / (8 * rayon::current_num_threads())).clamp(1, 512)
-}
 
 /// Sets the smallest stage that runs on every thread (tests: 1, to split small scenes).
 pub fn set_min_parallel(n: usize) {
     MIN_PARALLEL.store(n, Ordering::Relaxed);
 }
 
-fn parallel(n: usize) -> bool {
-    n >= MIN_PARALLEL.load(Ordering::Relaxed) && rayon::current_num_threads() > 1
+/// The number of threads a stage of n items runs on (1: the calling thread alone).
+fn threads_for(n: usize) -> usize {
+    let t = rayon::current_num_threads();
+    if n >= MIN_PARALLEL.load(Ordering::Relaxed) && t > 1 {
+        t.min(n)
+    } else {
+        1
+    }
+}
+
+/// Where the shares of n items split for `parts` threads: thread t takes
+/// bounds[t]..bounds[t + 1], contiguous and of equal size to within one `align`, so that
+/// a thread treats the same particles (and their pairs) in every stage.
+fn bounds(n: usize, parts: usize, align: usize) -> Vec<usize> {
+    let blocks = n.div_ceil(align);
+    (0..=parts)
+        .map(|t| (blocks * t / parts * align).min(n))
+        .collect()
+}
+
+/// v cut at `bounds`, one share per thread (each behind a lock that only its thread takes).
+fn shares<'a, T>(mut v: &'a mut [T], bounds: &[usize]) -> Vec<Mutex<&'a mut [T]>> {
+    let mut out = Vec::with_capacity(bounds.len() - 1);
+    for w in bounds.windows(2) {
+        let (share, rest) = std::mem::take(&mut v).split_at_mut(w[1] - w[0]);
+        out.push(Mutex::new(share));
+        v = rest;
+    }
+    out
+}
+
+/// Share t of `shares` (taken by thread t only).
+fn take<'b, 'a, T>(shares: &'b [Mutex<&'a mut [T]>], t: usize) -> std::sync::MutexGuard<'b, &'a mut [T]> {
+    shares[t].lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// f(k, &mut v[k]) for every k.
@@ -35,15 +64,14 @@ where
     T: Send,
     F: Fn(usize, &mut T) + Sync + Send,
 {
-    if parallel(v.len()) {
-        let c = chunk(v.len());
-        v.par_iter_mut()
-            .enumerate()
-            .with_min_len(c)
-            .for_each(|(k, x)| f(k, x));
-    } else {
-        v.iter_mut().enumerate().for_each(|(k, x)| f(k, x));
-    }
+    let parts = threads_for(v.len());
+    let b = bounds(v.len(), parts, 1);
+    let s = shares(v, &b);
+    crate::team::run(parts, &|t| {
+        for (m, x) in take(&s, t).iter_mut().enumerate() {
+            f(b[t] + m, x);
+        }
+    });
 }
 
 /// f(k, &mut a[k], &mut b[k]) for every k (a and b of equal length).
@@ -53,20 +81,7 @@ where
     B: Send,
     F: Fn(usize, &mut A, &mut B) + Sync + Send,
 {
-    assert_eq!(a.len(), b.len());
-    if parallel(a.len()) {
-        let c = chunk(a.len());
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .enumerate()
-            .with_min_len(c)
-            .for_each(|(k, (x, y))| f(k, x, y));
-    } else {
-        a.iter_mut()
-            .zip(b.iter_mut())
-            .enumerate()
-            .for_each(|(k, (x, y))| f(k, x, y));
-    }
+    for_each_block2(a, b, 1, |k, x, y| f(k, &mut x[0], &mut y[0]));
 }
 
 /// f(k0, &mut a[k0..k0 + m], &mut b[k0..k0 + m]) for consecutive blocks of m ≤ `block`
@@ -78,18 +93,15 @@ where
     F: Fn(usize, &mut [A], &mut [B]) + Sync + Send,
 {
     assert_eq!(a.len(), b.len());
-    if parallel(a.len()) {
-        let c = chunk(a.len()).div_ceil(block);
-        a.par_chunks_mut(block)
-            .zip(b.par_chunks_mut(block))
-            .enumerate()
-            .with_min_len(c)
-            .for_each(|(m, (x, y))| f(m * block, x, y));
-    } else {
-        for (m, (x, y)) in a.chunks_mut(block).zip(b.chunks_mut(block)).enumerate() {
-            f(m * block, x, y);
+    let parts = threads_for(a.len());
+    let bd = bounds(a.len(), parts, block);
+    let (sa, sb) = (shares(a, &bd), shares(b, &bd));
+    crate::team::run(parts, &|t| {
+        let (mut x, mut y) = (take(&sa, t), take(&sb, t));
+        for (m, (x, y)) in x.chunks_mut(block).zip(y.chunks_mut(block)).enumerate() {
+            f(bd[t] + m * block, x, y);
         }
-    }
+    });
 }
 
 /// f(k, [&mut v0[k], …, &mut v5[k]]) for every k: the six Gear values of a particle.
@@ -124,39 +136,30 @@ where
     V: Send,
     F: Fn(usize, [&mut T; 6], &mut U, &mut V) + Sync + Send,
 {
-    let [a, b, c, d, e, g] = v;
-    let n = a.len();
+    let n = v[0].len();
+    assert!(v.iter().all(|q| q.len() == n));
     assert_eq!(w.len(), n);
     assert_eq!(x.len(), n);
-    if parallel(n) {
-        a.par_iter_mut()
-            .zip(b.par_iter_mut())
-            .zip(c.par_iter_mut())
-            .zip(d.par_iter_mut())
-            .zip(e.par_iter_mut())
-            .zip(g.par_iter_mut())
-            .zip(w.par_iter_mut())
-            .zip(x.par_iter_mut())
-            .enumerate()
-            .with_min_len(chunk(n))
-            .for_each(|(k, (((((((q0, q1), q2), q3), q4), q5), y), z))| {
-                f(k, [q0, q1, q2, q3, q4, q5], y, z)
-            });
-    } else {
-        for (k, (((((((q0, q1), q2), q3), q4), q5), y), z)) in a
-            .iter_mut()
-            .zip(b.iter_mut())
+    let parts = threads_for(n);
+    let b = bounds(n, parts, 1);
+    let q = v.each_mut().map(|q| shares(q, &b));
+    let (sw, sx) = (shares(w, &b), shares(x, &b));
+    crate::team::run(parts, &|t| {
+        let mut g = [0, 1, 2, 3, 4, 5].map(|d| take(&q[d], t));
+        let (mut w, mut x) = (take(&sw, t), take(&sx, t));
+        let [a, b1, c, d, e, h] = &mut g;
+        let rows = (a.iter_mut())
+            .zip(b1.iter_mut())
             .zip(c.iter_mut())
             .zip(d.iter_mut())
             .zip(e.iter_mut())
-            .zip(g.iter_mut())
+            .zip(h.iter_mut())
             .zip(w.iter_mut())
-            .zip(x.iter_mut())
-            .enumerate()
-        {
-            f(k, [q0, q1, q2, q3, q4, q5], y, z);
+            .zip(x.iter_mut());
+        for (m, (((((((q0, q1), q2), q3), q4), q5), y), z)) in rows.enumerate() {
+            f(b[t] + m, [q0, q1, q2, q3, q4, q5], y, z);
         }
-    }
+    });
 }
 
 /// The first k in 0..n for which f(k) holds (the same k whatever the thread count).
@@ -164,17 +167,14 @@ pub fn position_first<F>(n: usize, f: F) -> Option<usize>
 where
     F: Fn(usize) -> bool + Sync + Send,
 {
-    if parallel(n) {
-        // Each task scans its block on its own and the smallest hit wins: rayon's
-        // position_first would synchronise on every item.
-        let c = chunk(n);
-        (0..n.div_ceil(c))
-            .into_par_iter()
-            .filter_map(|b| (b * c..n.min((b + 1) * c)).find(|&k| f(k)))
-            .min()
-    } else {
-        (0..n).position(f)
-    }
+    let parts = threads_for(n);
+    let b = bounds(n, parts, 1);
+    let hits: Vec<Mutex<Option<usize>>> = (0..parts).map(|_| Mutex::new(None)).collect();
+    crate::team::run(parts, &|t| {
+        *take_slot(&hits, t) = (b[t]..b[t + 1]).find(|&k| f(k));
+    });
+    hits.into_iter()
+        .find_map(|h| h.into_inner().unwrap_or_else(|e| e.into_inner()))
 }
 
 /// [f(0), …, f(n − 1)], in order.
@@ -183,20 +183,29 @@ where
     T: Send,
     F: Fn(usize) -> T + Sync + Send,
 {
-    if parallel(n) {
-        (0..n)
-            .into_par_iter()
-            .with_min_len(chunk(n))
-            .map(f)
-            .collect()
-    } else {
-        (0..n).map(f).collect()
+    let parts = threads_for(n);
+    if parts == 1 {
+        return (0..n).map(f).collect();
     }
+    let b = bounds(n, parts, 1);
+    let out: Vec<Mutex<Vec<T>>> = (0..parts).map(|_| Mutex::new(Vec::new())).collect();
+    crate::team::run(parts, &|t| {
+        *take_slot(&out, t) = (b[t]..b[t + 1]).map(&f).collect();
+    });
+    let mut all = Vec::with_capacity(n);
+    for o in out {
+        all.append(&mut o.into_inner().unwrap_or_else(|e| e.into_inner()));
+    }
+    all
+}
+
+fn take_slot<T>(slots: &[Mutex<T>], t: usize) -> std::sync::MutexGuard<'_, T> {
+    slots[t].lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// Sorts v (unstable: for keys that are all different, the order is the same either way).
 pub fn sort_unstable<T: Ord + Send>(v: &mut [T]) {
-    if parallel(v.len()) {
+    if threads_for(v.len()) > 1 {
         v.par_sort_unstable();
     } else {
         v.sort_unstable();
