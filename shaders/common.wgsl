@@ -182,47 +182,9 @@ struct Candidate {
     _pad: u32,
 };
 
-@group(0) @binding(0) var<uniform> params: Params;
-@group(0) @binding(1) var<storage, read_write> state: array<State>;
-@group(0) @binding(2) var<storage, read_write> props: array<Props>;
-@group(0) @binding(3) var<storage, read_write> cell_of: array<u32>;
-@group(0) @binding(4) var<storage, read_write> cell_count: array<atomic<u32>>;
-@group(0) @binding(5) var<storage, read_write> cell_start: array<u32>;
-@group(0) @binding(6) var<storage, read_write> scan: array<u32>;
-@group(0) @binding(7) var<storage, read_write> sorted: array<u32>;
-@group(0) @binding(8) var<storage, read_write> contact_j: array<u32>;
-@group(0) @binding(9) var<storage, read_write> contact_count: array<u32>;
-@group(0) @binding(10) var<storage, read_write> down: array<u32>;
-@group(0) @binding(11) var<storage, read_write> down_count: array<atomic<u32>>;
-@group(0) @binding(12) var<storage, read_write> hist_in: array<f32>;
-// Whether each candidate of the lists touched at the last evaluation (1) or not (0).
-@group(0) @binding(13) var<storage, read_write> touching: array<u32>;
-// Each candidate's result, one array per use so that each takes 16 bytes per slot (256
-// per particle: 5.2e5 particles in lavapipe's 128 MiB binding) and the reduction reads
-// only what it sums: (f_x, f_z) on i, torque on i, torque on j.
-@group(0) @binding(14) var<storage, read_write> contact_ft: array<vec4<f32>>;
-@group(0) @binding(15) var<storage, read_write> force: array<vec4<f32>>;
-@group(0) @binding(16) var<storage, read_write> walls: array<Wall>;
-@group(0) @binding(17) var<storage, read_write> control: array<atomic<u32>>;
-@group(0) @binding(18) var<storage, read_write> sources: array<Source>;
-@group(0) @binding(19) var<storage, read_write> candidates: array<Candidate>;
-// Polygon corners in whole position units (counter-clockwise, centroid at the origin):
-// xy in the body frame, zw rotated to the particle's orientation (orientation.wgsl).
-@group(0) @binding(20) var<storage, read_write> corners: array<vec4<i32>>;
-// Each memory slot's particle id (issue 13 item 4): the particles are sorted in memory
-// by cell at every rebuild; ids never change, and every choice of order (a pair's lower
-// id, the order of sums, the spring table's keys, the reported particle) goes by id, so
-// no result depends on where a particle lies in memory.
-@group(0) @binding(21) var<storage, read_write> ids: array<u32>;
-// The particles in their new order, on the way (permute.wgsl).
-@group(0) @binding(22) var<storage, read_write> state_next: array<State>;
-@group(0) @binding(23) var<storage, read_write> props_next: array<Props>;
-@group(0) @binding(24) var<storage, read_write> ids_next: array<u32>;
-// For outputs only (written for the candidates that touch, never read by the kernels):
-// (f_n, f_t, overlap, elastic energy) and the geometry the force was computed with, the
-// normal (n_x, n_z) from j to i and the contact point relative to i's centre (issue 19).
-@group(0) @binding(25) var<storage, read_write> contact_info: array<vec4<f32>>;
-@group(0) @binding(26) var<storage, read_write> contact_geo: array<vec4<f32>>;
+// The bindings are declared after this file, generated from src/gpu/bindings.rs
+// BINDINGS: `read` where no entry point of the module writes the buffer.
+
 // Every candidate of the lists as one compact list of `count` slots (i MAX_CONTACTS +
 // k), written by find_contacts at a rebuild, for contact_forces under the overlap-area
 // law, which takes one thread per pair (issue 14 item 5). clear_cells empties it.
@@ -230,10 +192,6 @@ struct PairList {
     count: atomic<u32>,
     slot: array<u32>,
 };
-@group(0) @binding(27) var<storage, read_write> pairs: PairList;
-// The spring table keyed by pair: touched only at a rebuild of the lists, which stores
-// the old lists' springs into it and gathers the new lists' from it (issue 13).
-@group(1) @binding(0) var<storage, read_write> table: array<Entry>;
 
 fn is_active(i: u32) -> bool {
     return (props[i].flags & ACTIVE) != 0u;

@@ -11,7 +11,7 @@
 // host's workgroup counts (written once at the upload); and the same at 4(R + k): this
 // step's arguments, R the number of rebuild stages.
 
-@group(2) @binding(0) var<storage, read_write> dispatch_args: array<u32>;
+// dispatch_args: group 2 (src/gpu/bindings.rs).
 
 @compute @workgroup_size(WG)
 fn plan_rebuild(@builtin(local_invocation_index) l: u32) {

@@ -35,9 +35,10 @@ fn every_kernel_module_validates() {
 
 #[test]
 fn every_binding_is_the_one_rust_binds() {
-    // src/gpu/buffers.rs `BINDINGS` is the one list the bind groups are built from: every
-    // variable the WGSL declares with a binding is in it, at the same group and binding,
-    // and nothing else is (the plan module declares group 2 besides common.wgsl's).
+    // src/gpu/bindings.rs `BINDINGS` is the one list the declarations and the bind
+    // groups are built from: every variable the assembled WGSL declares with a binding
+    // is in it, at the same group and binding, with a type the WGSL knows, and nothing
+    // else is (the plan module declares group 2 besides the others).
     let src = MODULES.iter().find(|m| m.name == "plan").unwrap().source();
     let module = parse("plan", &src);
     let mut wgsl: Vec<(String, u32, u32)> = module
@@ -194,4 +195,64 @@ fn the_pair_hash_is_asymmetric_and_spreads_neighbours() {
         }
     }
     assert!(seen.len() > 300, "neighbouring pairs spread over the table");
+}
+
+#[test]
+fn bindings_are_declared_only_from_the_rust_list() {
+    // src/gpu/bindings.rs BINDINGS is the one source: no WGSL file declares a binding by
+    // hand (a stale one there would shadow or clash with the generated declaration).
+    for m in MODULES {
+        for part in m.parts {
+            assert!(
+                !part.contains("@group(") && !part.contains("@binding("),
+                "a file of {}.wgsl declares a binding; add it to BINDINGS instead",
+                m.name
+            );
+        }
+    }
+}
+
+#[test]
+fn each_kernel_binds_read_only_what_it_never_writes() {
+    use talus::gpu::BINDINGS;
+    use talus::gpu::bindings::kernel_modules;
+    use talus::gpu::kernels::Kernel;
+    let access = |k: Kernel, name: &str| {
+        let km = &kernel_modules()[&k];
+        let i = BINDINGS.iter().position(|b| b.name == name).unwrap();
+        match (km.touched[i], km.writable[i]) {
+            (false, _) => "-",
+            (true, false) => "r",
+            (true, true) => "rw",
+        }
+    };
+    let mut table = String::new();
+    for k in Kernel::ALL {
+        let row: Vec<String> = (BINDINGS.iter())
+            .filter(|b| access(k, b.name) != "-")
+            .map(|b| format!("{}:{}", b.name, access(k, b.name)))
+            .collect();
+        table += &format!("{k:?}: {}\n", row.join(" "));
+    }
+    println!("{table}");
+    // The contact kernel reads the particles and the lists, and writes only the
+    // candidates' results and springs.
+    for name in ["state", "props", "corners", "walls", "contact_j", "contact_count"] {
+        assert_eq!(access(Kernel::ContactForcesOnly, name), "r", "contact_forces {name}");
+    }
+    for name in ["contact_ft", "touching", "hist_in"] {
+        assert_eq!(access(Kernel::ContactForcesOnly, name), "rw", "contact_forces {name}");
+    }
+    // It never touches the spring table or the particles on their way to a new order.
+    for name in ["table", "state_next", "sorted"] {
+        assert_eq!(access(Kernel::ContactForcesOnly, name), "-", "contact_forces {name}");
+    }
+    // The integrator writes the state and only reads the candidates' results.
+    assert_eq!(access(Kernel::CorrectAhead, "state"), "rw");
+    assert_eq!(access(Kernel::CorrectAhead, "contact_ft"), "r");
+    // The rebuild's history transfer reads what the other side writes.
+    assert_eq!(access(Kernel::StoreHistory, "hist_in"), "r");
+    assert_eq!(access(Kernel::StoreHistory, "table"), "rw");
+    assert_eq!(access(Kernel::GatherHistory, "table"), "r");
+    assert_eq!(access(Kernel::GatherHistory, "hist_in"), "rw");
 }

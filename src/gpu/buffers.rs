@@ -4,73 +4,6 @@
 
 use super::*;
 
-/// A WGSL variable's binding.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Binding {
-    pub name: &'static str,
-    pub group: u32,
-    pub binding: u32,
-}
-
-const fn bind(name: &'static str, group: u32, binding: u32) -> Binding {
-    Binding {
-        name,
-        group,
-        binding,
-    }
-}
-
-/// Every binding of the talus kernels, by WGSL name: the one list the bind groups and
-/// their layouts are built from (`kernels::Pipelines`), checked against the WGSL's
-/// declarations by tests/gpu_layout.rs. Group 0: the uniform `params`, then every per-run
-/// and per-step array; group 1: the spring table; group 2: the rebuild stages' indirect
-/// arguments (`plan_rebuild`, `plan_pairs` only).
-pub const BINDINGS: [Binding; 30] = [
-    bind("params", 0, 0),
-    bind("state", 0, 1),
-    bind("props", 0, 2),
-    bind("cell_of", 0, 3),
-    bind("cell_count", 0, 4),
-    bind("cell_start", 0, 5),
-    bind("scan", 0, 6),
-    bind("sorted", 0, 7),
-    bind("contact_j", 0, 8),
-    bind("contact_count", 0, 9),
-    bind("down", 0, 10),
-    bind("down_count", 0, 11),
-    bind("hist_in", 0, 12),
-    bind("touching", 0, 13),
-    bind("contact_ft", 0, 14),
-    bind("force", 0, 15),
-    bind("walls", 0, 16),
-    bind("control", 0, 17),
-    bind("sources", 0, 18),
-    bind("candidates", 0, 19),
-    bind("corners", 0, 20),
-    bind("ids", 0, 21),
-    bind("state_next", 0, 22),
-    bind("props_next", 0, 23),
-    bind("ids_next", 0, 24),
-    bind("contact_info", 0, 25),
-    bind("contact_geo", 0, 26),
-    bind("pairs", 0, 27),
-    bind("table", 1, 0),
-    bind("dispatch_args", 2, 0),
-];
-
-/// Storage bindings of a group (group 0's binding 0 is the uniform `params`).
-pub const fn storage_bindings(group: u32) -> u32 {
-    let mut n = 0;
-    let mut k = 0;
-    while k < BINDINGS.len() {
-        if BINDINGS[k].group == group && !(group == 0 && BINDINGS[k].binding == 0) {
-            n += 1;
-        }
-        k += 1;
-    }
-    n
-}
-
 /// Every buffer of a run, by its WGSL name.
 pub(super) struct Buffers {
     pub(super) params: wgpu::Buffer,
@@ -238,35 +171,30 @@ impl Buffers {
         })
     }
 
-    /// The bind groups of the talus kernels (`kernels::Pipelines`' layouts), from
-    /// `BINDINGS`.
-    pub(super) fn bind_groups(
-        &self,
-        dev: &wgpu::Device,
-        pipelines: &Pipelines,
-    ) -> [wgpu::BindGroup; 3] {
-        let group = |g: u32, layout: &wgpu::BindGroupLayout, label: &str| {
-            let entries: Vec<_> = BINDINGS
-                .iter()
-                .filter(|b| b.group == g)
-                .map(|b| wgpu::BindGroupEntry {
-                    binding: b.binding,
-                    resource: self
-                        .named(b.name)
-                        .unwrap_or_else(|| panic!("no buffer for binding {}", b.name))
-                        .as_entire_binding(),
+    /// The bind groups of the talus kernels, one per shape in `Pipelines::groups`.
+    pub(super) fn bind_groups(&self, dev: &wgpu::Device, pipelines: &Pipelines) -> Vec<wgpu::BindGroup> {
+        (pipelines.groups.iter())
+            .map(|((g, shape), layout)| {
+                let entries: Vec<_> = (shape.iter())
+                    .map(|&(binding, _)| {
+                        let b = (BINDINGS.iter())
+                            .find(|b| b.group == *g && b.binding == binding)
+                            .expect("a layout's bindings are in BINDINGS");
+                        wgpu::BindGroupEntry {
+                            binding,
+                            resource: self
+                                .named(b.name)
+                                .unwrap_or_else(|| panic!("no buffer for binding {}", b.name))
+                                .as_entire_binding(),
+                        }
+                    })
+                    .collect();
+                dev.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("talus"),
+                    layout,
+                    entries: &entries,
                 })
-                .collect();
-            dev.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some(label),
-                layout,
-                entries: &entries,
             })
-        };
-        [
-            group(0, &pipelines.group0, "talus group 0"),
-            group(1, &pipelines.group1, "springs"),
-            group(2, &pipelines.group2, "dispatch arguments"),
-        ]
+            .collect()
     }
 }

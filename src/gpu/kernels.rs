@@ -1,6 +1,8 @@
 //! The WGSL sources and their compute pipelines. Each stage file in `shaders/` is
-//! compiled after `common.wgsl`, `position.wgsl`, `orientation.wgsl` and the helper files it uses; every pipeline shares one
-//! pipeline layout (`common.wgsl`'s bindings), so a step binds its buffers once.
+//! compiled after `common.wgsl`, `position.wgsl`, `orientation.wgsl` and the helper
+//! files it uses, followed by the binding declarations generated for the module
+//! (`bindings.rs`). Each kernel has its own pipeline layout: the bindings its entry
+//! point touches, read-only where its module never writes them.
 
 /// A shader module: the stage file and the helper files it needs.
 pub struct ModuleSource {
@@ -174,9 +176,19 @@ pub const MODULES: &[ModuleSource] = &[
     },
 ];
 
+use super::bindings::GroupShape;
+
 impl ModuleSource {
+    /// The module's WGSL: its files and its bindings, every storage buffer
+    /// `read_write` (each kernel is compiled from it reduced to its entry point, with
+    /// what that does not write made `read`: `bindings::kernel_modules`).
     pub fn source(&self) -> String {
-        self.parts.join("\n")
+        self.source_with(|_| true)
+    }
+
+    /// The module with the bindings `writable` says declared `read_write`.
+    pub fn source_with(&self, writable: impl Fn(&super::bindings::Binding) -> bool) -> String {
+        self.parts.join("\n") + &super::bindings::declarations(self.name, writable)
     }
 }
 
@@ -285,16 +297,22 @@ impl Kernel {
 /// table) and of group 2 (the indirect dispatch arguments, bound only to
 /// `plan_rebuild`: a buffer cannot be an indirect argument and writable storage in one
 /// dispatch).
-pub const GROUP0_STORAGE: u32 = super::buffers::storage_bindings(0);
-pub const GROUP1_STORAGE: u32 = super::buffers::storage_bindings(1);
-pub const GROUP2_STORAGE: u32 = super::buffers::storage_bindings(2);
+pub const GROUP0_STORAGE: u32 = super::bindings::storage_bindings(0);
+pub const GROUP1_STORAGE: u32 = super::bindings::storage_bindings(1);
+pub const GROUP2_STORAGE: u32 = super::bindings::storage_bindings(2);
 
-fn storage_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+/// A layout entry: the uniform `params` (group 0, binding 0) or a storage buffer.
+fn layout_entry(group: u32, binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    let ty = if group == 0 && binding == 0 {
+        wgpu::BufferBindingType::Uniform
+    } else {
+        wgpu::BufferBindingType::Storage { read_only }
+    };
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::COMPUTE,
         ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: false },
+            ty,
             has_dynamic_offset: false,
             min_binding_size: None,
         },
@@ -350,58 +368,53 @@ impl Build {
 }
 
 pub struct Pipelines {
-    pub group0: wgpu::BindGroupLayout,
-    pub group1: wgpu::BindGroupLayout,
-    pub group2: wgpu::BindGroupLayout,
+    /// Every distinct bind group shape of the kernels, with its layout.
+    pub groups: Vec<(GroupShape, wgpu::BindGroupLayout)>,
+    /// Per kernel, the bind groups it sets (indices into `groups`), by group.
+    pub kernel_groups: std::collections::HashMap<Kernel, [Option<usize>; 3]>,
     pub pipelines: std::collections::HashMap<Kernel, wgpu::ComputePipeline>,
 }
 
 impl Pipelines {
     /// The pipelines of every kernel, the contact kernels built for `build`.
     pub fn new(device: &wgpu::Device, build: Build) -> Self {
-        let mut entries = vec![wgpu::BindGroupLayoutEntry {
-            binding: 0,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Uniform,
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        }];
-        entries.extend((1..=GROUP0_STORAGE).map(storage_entry));
-        let group0 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("talus group 0"),
-            entries: &entries,
-        });
-        let group1 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("talus springs"),
-            entries: &(0..GROUP1_STORAGE).map(storage_entry).collect::<Vec<_>>(),
-        });
-        let group2 = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("talus dispatch arguments"),
-            entries: &(0..GROUP2_STORAGE).map(storage_entry).collect::<Vec<_>>(),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("talus"),
-            bind_group_layouts: &[Some(&group0), Some(&group1)],
-            immediate_size: 0,
-        });
-        let plan_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("talus plan"),
-            bind_group_layouts: &[Some(&group0), Some(&group1), Some(&group2)],
-            immediate_size: 0,
-        });
-        let modules: std::collections::HashMap<&str, wgpu::ShaderModule> = MODULES
-            .iter()
-            .map(|m| {
-                let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-                    label: Some(m.name),
-                    source: wgpu::ShaderSource::Wgsl(m.source().into()),
-                });
-                (m.name, module)
-            })
-            .collect();
+        let mut groups: Vec<(GroupShape, wgpu::BindGroupLayout)> = Vec::new();
+        let mut kernel_groups = std::collections::HashMap::new();
+        let mut layouts = std::collections::HashMap::new();
+        for k in Kernel::ALL {
+            let (_, entry) = k.entry();
+            let sets = super::bindings::kernel_groups(k).map(|shape| {
+                let shape = shape?;
+                Some(match groups.iter().position(|(s, _)| *s == shape) {
+                    Some(i) => i,
+                    None => {
+                        let entries: Vec<_> = (shape.1.iter())
+                            .map(|&(b, read_only)| layout_entry(shape.0, b, read_only))
+                            .collect();
+                        let layout =
+                            device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                                label: Some(entry),
+                                entries: &entries,
+                            });
+                        groups.push((shape, layout));
+                        groups.len() - 1
+                    }
+                })
+            });
+            let used = sets.iter().rposition(Option::is_some).map_or(0, |g| g + 1);
+            let bind_group_layouts: Vec<Option<&wgpu::BindGroupLayout>> = sets[..used]
+                .iter()
+                .map(|s| s.map(|i| &groups[i].1))
+                .collect();
+            let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some(entry),
+                bind_group_layouts: &bind_group_layouts,
+                immediate_size: 0,
+            });
+            kernel_groups.insert(k, sets);
+            layouts.insert(k, layout);
+        }
+        let modules = super::bindings::kernel_modules();
         let pipelines = Kernel::ALL
             .iter()
             .map(|&k| {
@@ -434,12 +447,13 @@ impl Pipelines {
                 };
                 let p = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                     label: Some(entry),
-                    layout: Some(if matches!(k, Kernel::PlanRebuild | Kernel::PlanPairs) {
-                        &plan_layout
-                    } else {
-                        &layout
+                    layout: Some(&layouts[&k]),
+                    module: &device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                        label: Some(entry),
+                        source: wgpu::ShaderSource::Naga(std::borrow::Cow::Borrowed(
+                            &modules[&k].module,
+                        )),
                     }),
-                    module: &modules[module],
                     entry_point: Some(entry),
                     compilation_options: wgpu::PipelineCompilationOptions {
                         constants,
@@ -451,9 +465,8 @@ impl Pipelines {
             })
             .collect();
         Self {
-            group0,
-            group1,
-            group2,
+            groups,
+            kernel_groups,
             pipelines,
         }
     }

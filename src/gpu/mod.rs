@@ -14,6 +14,7 @@
 //! |---|---|
 //! | `mod.rs` | `GpuSimulation`: the upload (`with_gpu`), sizes and limits |
 //! | `params.rs` | `Params`, the uniform every kernel reads |
+//! | `bindings.rs` | every binding, and which kernel reads or writes it |
 //! | `buffers.rs` | the buffers and their bind groups |
 //! | `step.rs` | encoding steps, pipelined batches, halts |
 //! | `insert.rs` | point sources' candidates, layered rows |
@@ -21,9 +22,10 @@
 //! | `buckets.rs` | the hashed grid |
 //! | `device.rs`, `kernels.rs`, `layout.rs`, `position.rs`, `orientation.rs` | adapters, pipelines, shared layouts, fixed point |
 
+pub mod bindings;
 mod buckets;
 mod buffers;
-pub use buffers::{BINDINGS, Binding};
+pub use bindings::{BINDINGS, Binding};
 pub mod device;
 mod insert;
 pub mod kernels;
@@ -75,11 +77,8 @@ pub struct GpuSimulation {
     gpu: Gpu,
     pipelines: Pipelines,
     buffers: Buffers,
-    group0: wgpu::BindGroup,
-    /// The spring table's group.
-    group1: wgpu::BindGroup,
-    /// The indirect dispatch arguments' group (`plan_rebuild` only).
-    group2: wgpu::BindGroup,
+    /// One bind group per shape of `pipelines.groups`.
+    bind_groups: Vec<wgpu::BindGroup>,
     pub params: Params,
     /// The device's grid: cells of at least the law's range plus the neighbour lists'
     /// skin (positions are anchored to its cells, see `position`).
@@ -286,7 +285,7 @@ impl GpuSimulation {
         let dev = &gpu.device;
         let buffers = Buffers::new(dev, &params, cells, &initial);
         let pipelines = Pipelines::new(dev, kernels::Build::of(&sim, &gpu.info));
-        let [group0, group1, group2] = buffers.bind_groups(dev, &pipelines);
+        let bind_groups = buffers.bind_groups(dev, &pipelines);
         let lost_base = sim.lost;
         let inactive_at_upload = (sim.particles.len() - sim.particles.active_count()) as u64;
         let step = sim.step;
@@ -295,9 +294,7 @@ impl GpuSimulation {
             gpu,
             pipelines,
             buffers,
-            group0,
-            group1,
-            group2,
+            bind_groups,
             params,
             grid,
             n_cap,

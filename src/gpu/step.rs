@@ -124,15 +124,19 @@ impl GpuSimulation {
 
     pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, k: Kernel, groups: u64) {
         self.dispatches.set(self.dispatches.get() + 1);
-        pass.set_pipeline(&self.pipelines.pipelines[&k]);
+        self.set_kernel(pass, k);
         pass.dispatch_workgroups(groups.max(1) as u32, 1, 1);
     }
 
-    /// Sets every bind group of the talus kernels on a pass.
-    pub(super) fn bind_groups(&self, pass: &mut wgpu::ComputePass) {
-        pass.set_bind_group(0, &self.group0, &[]);
-        pass.set_bind_group(1, &self.group1, &[]);
-        pass.set_bind_group(2, &self.group2, &[]);
+    /// Sets a kernel's pipeline and its bind groups (`bindings.rs`: only the buffers it
+    /// touches, read-only where its module never writes them).
+    fn set_kernel(&self, pass: &mut wgpu::ComputePass, k: Kernel) {
+        pass.set_pipeline(&self.pipelines.pipelines[&k]);
+        for (g, set) in self.pipelines.kernel_groups[&k].iter().enumerate() {
+            if let Some(i) = set {
+                pass.set_bind_group(g as u32, &self.bind_groups[*i], &[]);
+            }
+        }
     }
 
     /// Records the dispatches of one kernel (for tests of single stages). Under the
@@ -145,7 +149,7 @@ impl GpuSimulation {
         if per_pair {
             self.dispatch(pass, Kernel::PlanPairs, 1);
             self.dispatches.set(self.dispatches.get() + 1);
-            pass.set_pipeline(&self.pipelines.pipelines[&k]);
+            self.set_kernel(pass, k);
             pass.dispatch_workgroups_indirect(&self.buffers.dispatch_args, PAIR_ARGS_OFFSET as u64);
         } else {
             self.dispatch(pass, k, workgroups(&self.params, k));
@@ -157,7 +161,7 @@ impl GpuSimulation {
     pub(super) fn dispatch_rebuild_stage(&self, pass: &mut wgpu::ComputePass, stage: usize) {
         self.indirect.set(self.indirect.get() + 1);
         let k = REBUILD_STAGES[stage];
-        pass.set_pipeline(&self.pipelines.pipelines[&k]);
+        self.set_kernel(pass, k);
         let offset = (REBUILD_STAGES.len() + stage) * DISPATCH_ARGS_BYTES;
         pass.dispatch_workgroups_indirect(&self.buffers.dispatch_args, offset as u64);
     }
@@ -168,7 +172,6 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            self.bind_groups(&mut pass);
             self.dispatch(&mut pass, k, groups);
         }
         self.gpu.queue.submit([enc.finish()]);
@@ -180,7 +183,6 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            self.bind_groups(&mut pass);
             for &k in ks {
                 self.encode_kernel(&mut pass, k);
             }
@@ -339,7 +341,6 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
-            self.bind_groups(&mut pass);
             let mut how = first;
             for step in 1..=k {
                 let end = step == k;

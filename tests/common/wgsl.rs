@@ -27,7 +27,8 @@ pub fn run_wgsl_fn(
     assert_eq!(input.len() % n_in, 0, "whole items");
     let items = input.len() / n_in;
     let gpu = super::gpu(test)?;
-    let mut source = parts.join("\n");
+    // The kernels' bindings, as every module declares them (src/gpu/bindings.rs).
+    let mut source = parts.join("\n") + &talus::gpu::bindings::declarations("wgsl_fn", |_| true);
     // The harness's buffers go in group 1 beside the spring table, at bindings no kernel
     // uses; the layout is derived from what the entry point uses.
     source += &format!(
