@@ -31,6 +31,7 @@ pub mod rng;
 pub mod run;
 pub mod scene;
 pub mod shape;
+pub mod spheropolygon;
 pub mod sim;
 pub mod snapshot;
 pub mod springs;

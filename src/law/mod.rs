@@ -7,6 +7,7 @@
 //! equation next to it, so a WGSL twin can be written line for line.
 
 pub mod continuous;
+pub mod hertz_cohesive;
 pub mod overlap_area;
 pub mod spring_dashpot;
 pub mod tangential;
