@@ -54,7 +54,10 @@ fn shares<'a, T>(mut v: &'a mut [T], bounds: &[usize]) -> Vec<Mutex<&'a mut [T]>
 }
 
 /// Share t of `shares` (taken by thread t only).
-fn take<'b, 'a, T>(shares: &'b [Mutex<&'a mut [T]>], t: usize) -> std::sync::MutexGuard<'b, &'a mut [T]> {
+fn take<'b, 'a, T>(
+    shares: &'b [Mutex<&'a mut [T]>],
+    t: usize,
+) -> std::sync::MutexGuard<'b, &'a mut [T]> {
     shares[t].lock().unwrap_or_else(|e| e.into_inner())
 }
 

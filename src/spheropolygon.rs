@@ -245,13 +245,20 @@ pub fn sub_contacts(
                     let l = norm(edge);
                     let m = [edge[1] / l, -edge[0] / l];
                     let centre = if flip { sub([0.0, 0.0], d) } else { [0.0, 0.0] };
-                    if dot(m, sub(centre, c)) < 0.0 { [-m[0], -m[1]] } else { m }
+                    if dot(m, sub(centre, c)) < 0.0 {
+                        [-m[0], -m[1]]
+                    } else {
+                        m
+                    }
                 };
                 let (r_vertex, r_edge) = if flip { (rq, rp) } else { (rp, rq) };
                 // The middle of the overlap: between the two surfaces along n.
                 let s_edge = [c[0] + r_edge * n[0], c[1] + r_edge * n[1]];
                 let s_vertex = [v[0] - r_vertex * n[0], v[1] - r_vertex * n[1]];
-                let arm = [0.5 * (s_edge[0] + s_vertex[0]), 0.5 * (s_edge[1] + s_vertex[1])];
+                let arm = [
+                    0.5 * (s_edge[0] + s_vertex[0]),
+                    0.5 * (s_edge[1] + s_vertex[1]),
+                ];
                 if flip {
                     n = [-n[0], -n[1]];
                 }
@@ -285,13 +292,114 @@ fn vertices(a: P2, b: P2, (rp, rq): (f64, f64), reach: f64, out: &mut Vec<SubCon
     } else {
         [0.0, 1.0]
     };
-    let (si, sj) = ([a[0] - rp * n[0], a[1] - rp * n[1]], [b[0] + rq * n[0], b[1] + rq * n[1]]);
+    let (si, sj) = (
+        [a[0] - rp * n[0], a[1] - rp * n[1]],
+        [b[0] + rq * n[0], b[1] + rq * n[1]],
+    );
     out.push(SubContact {
         key: VERTICES,
         delta: rp + rq - dist,
         n,
         arm: [0.5 * (si[0] + sj[0]), 0.5 * (si[1] + sj[1])],
     });
+}
+
+/// Sub-contact springs a pair keeps at most from one step to the next: a rod pair has
+/// at most four sub-contacts (two vertices on each side). Beyond that (polygon cores
+/// touching at many points) the shallowest sub-contacts' springs restart every step.
+pub const MAX_SUB: usize = 4;
+
+/// One pair's tangential springs, each keyed by its sub-contact (`SubContact::key`):
+/// what the neighbour list's slot holds for a spheropolygon pair between steps (SPEC 3:
+/// "keyed by the pair and the sub-contact").
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SubSprings {
+    pub count: usize,
+    pub key: [u32; MAX_SUB],
+    pub xi: [f64; MAX_SUB],
+}
+
+impl SubSprings {
+    /// The spring of a sub-contact, 0 for one that was not there at the last step.
+    pub fn get(&self, key: u32) -> f64 {
+        (0..self.count)
+            .find(|&k| self.key[k] == key)
+            .map_or(0.0, |k| self.xi[k])
+    }
+
+    fn push(&mut self, key: u32, xi: f64) {
+        if self.count < MAX_SUB {
+            self.key[self.count] = key;
+            self.xi[self.count] = xi;
+            self.count += 1;
+        }
+    }
+}
+
+/// What a pair of spheropolygons does to its particles this step.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PairForce {
+    /// The total force on i (on j: its opposite).
+    pub force: P2,
+    /// Torques on i and on j.
+    pub torque: [f64; 2],
+    /// The updated springs of the sub-contacts in range.
+    pub springs: SubSprings,
+    /// Each sub-contact in range with its law's output (forces along n and t).
+    pub contacts: Vec<(SubContact, crate::law::ContactOutput)>,
+}
+
+/// The motion of one body: velocity (x, z) and angular velocity.
+pub type Motion = [f64; 3];
+
+/// The force between spheropolygons i and j (`p`, `q`: their turned cores and sweep
+/// radii; `d` = r_i − r_j; `m12` the reduced mass, the mass of i against a wall) under
+/// paper 004's law, each sub-contact with its own spring from `springs` (SPEC 2.4). A
+/// wall is a spheropolygon of sweep radius 0 that does not move.
+#[allow(clippy::too_many_arguments)]
+pub fn pair_force(
+    law: &crate::law::hertz_cohesive::HertzCohesive,
+    p: (&[P2], f64),
+    q: (&[P2], f64),
+    d: P2,
+    (vi, vj): (Motion, Motion),
+    m12: f64,
+    springs: &SubSprings,
+    dt: f64,
+) -> PairForce {
+    let mut subs = Vec::new();
+    sub_contacts(p, q, d, law.d_c, &mut subs);
+    // The deepest first: they keep their springs when there are more than MAX_SUB.
+    subs.sort_by(|a, b| b.delta.total_cmp(&a.delta).then(a.key.cmp(&b.key)));
+    let mut out = PairForce::default();
+    for (k, c) in subs.into_iter().enumerate() {
+        // The contact point relative to each centre, and the velocity of each surface there.
+        let (li, lj) = (c.arm, [c.arm[0] + d[0], c.arm[1] + d[1]]);
+        let ui = [vi[0] - vi[2] * li[1], vi[1] + vi[2] * li[0]];
+        let uj = [vj[0] - vj[2] * lj[1], vj[1] + vj[2] * lj[0]];
+        let v12 = sub(ui, uj);
+        let t = [-c.n[1], c.n[0]];
+        let history = if k < MAX_SUB { springs.get(c.key) } else { 0.0 };
+        let input = crate::law::ContactInput {
+            delta: c.delta,
+            delta_dot: -dot(v12, c.n),
+            v_t: dot(v12, t),
+            m12,
+            history,
+            dt,
+            ..Default::default()
+        };
+        let r = law.evaluate(&input);
+        let f = [r.f_n * c.n[0] + r.f_t * t[0], r.f_n * c.n[1] + r.f_t * t[1]];
+        out.force = [out.force[0] + f[0], out.force[1] + f[1]];
+        out.torque[0] += cross(li, f);
+        out.torque[1] -= cross(lj, f);
+        if k < MAX_SUB {
+            out.springs.push(c.key, r.history);
+        }
+        out.contacts.push((c, r));
+    }
+    out
 }
 
 /// The point of segment a–b closest to p, and its parameter t ∈ [0, 1] along a → b.
@@ -352,7 +460,10 @@ mod tests {
         for (aspect, width) in [(2.0, 1.0), (5.0, 1.0), (10.0, 0.3), (1.0, 2.0)] {
             let rod = Spheropolygon::rod(aspect, width);
             let (area, polar) = stadium((aspect - 1.0) * width, 0.5 * width);
-            assert!((rod.area() - area).abs() < 1e-12 * area, "area, d = {aspect}");
+            assert!(
+                (rod.area() - area).abs() < 1e-12 * area,
+                "area, d = {aspect}"
+            );
             assert!(
                 (rod.polar_moment() - polar).abs() < 1e-12 * polar,
                 "inertia, d = {aspect}: {} against {polar}",
@@ -388,7 +499,11 @@ mod tests {
             x += h;
         }
         let c = s.centroid();
-        assert!((s.area() - a).abs() < 2e-3 * a, "area {} against {a}", s.area());
+        assert!(
+            (s.area() - a).abs() < 2e-3 * a,
+            "area {} against {a}",
+            s.area()
+        );
         assert!((c[0] - fx / a).abs() < 2e-3 && (c[1] - fz / a).abs() < 2e-3);
         let jc = j - a * ((fx / a).powi(2) + (fz / a).powi(2));
         assert!((s.polar_moment() - jc).abs() < 3e-3 * jc);
@@ -411,7 +526,10 @@ mod tests {
         // frame, i [−2, 2]: j's end at x = −1 and i's end at x = 2.
         let mut xs: Vec<f64> = out.iter().map(|c| c.arm[0]).collect();
         xs.sort_by(f64::total_cmp);
-        assert!((xs[0] + 1.0).abs() < 1e-12 && (xs[1] - 2.0).abs() < 1e-12, "{xs:?}");
+        assert!(
+            (xs[0] + 1.0).abs() < 1e-12 && (xs[1] - 2.0).abs() < 1e-12,
+            "{xs:?}"
+        );
     }
 
     #[test]
@@ -423,11 +541,23 @@ mod tests {
             core: vec![[0.0, -1.0], [0.0, 1.0]],
             radius: 0.5,
         };
-        sub_contacts((&rod.core, 0.5), (&upright.core, 0.5), [0.0, 1.98], 0.0, &mut out);
+        sub_contacts(
+            (&rod.core, 0.5),
+            (&upright.core, 0.5),
+            [0.0, 1.98],
+            0.0,
+            &mut out,
+        );
         assert_eq!(out.len(), 1, "{out:?}");
         assert!((out[0].delta - 0.02).abs() < 1e-12);
         // End to end along x: the two ends' vertices, once.
-        sub_contacts((&rod.core, 0.5), (&rod.core, 0.5), [2.99, 0.0], 0.0, &mut out);
+        sub_contacts(
+            (&rod.core, 0.5),
+            (&rod.core, 0.5),
+            [2.99, 0.0],
+            0.0,
+            &mut out,
+        );
         assert_eq!(out.len(), 1, "{out:?}");
         assert_eq!(out[0].key & VERTICES, VERTICES);
         assert!((out[0].delta - 0.01).abs() < 1e-12 && (out[0].n[0] - 1.0).abs() < 1e-15);
@@ -440,11 +570,19 @@ mod tests {
             2 => {
                 let l = 0.2 + 2.0 * rng.uniform();
                 let a = rng.uniform() * PI;
-                vec![[-0.5 * l * a.cos(), -0.5 * l * a.sin()], [0.5 * l * a.cos(), 0.5 * l * a.sin()]]
+                vec![
+                    [-0.5 * l * a.cos(), -0.5 * l * a.sin()],
+                    [0.5 * l * a.cos(), 0.5 * l * a.sin()],
+                ]
             }
             c => {
                 let start = rng.uniform() * PI;
-                crate::shape::ellipse_polygon(c as u32, 0.5 + rng.uniform(), 0.5 + rng.uniform(), start)
+                crate::shape::ellipse_polygon(
+                    c as u32,
+                    0.5 + rng.uniform(),
+                    0.5 + rng.uniform(),
+                    start,
+                )
             }
         };
         Spheropolygon {
@@ -473,14 +611,21 @@ mod tests {
                 for (a, b) in edges(v.len()) {
                     for k in 1..800 {
                         let f = k as f64 / 800.0;
-                        pts.push([v[a][0] + f * (v[b][0] - v[a][0]), v[a][1] + f * (v[b][1] - v[a][1])]);
+                        pts.push([
+                            v[a][0] + f * (v[b][0] - v[a][0]),
+                            v[a][1] + f * (v[b][1] - v[a][1]),
+                        ]);
                     }
                 }
                 pts
             };
             let (ps, qs) = (sample(&s.core), sample(&qi));
-            if ps.iter().any(|&x| t.core.len() >= 3 && inside_convex(&qi, x))
-                || qs.iter().any(|&x| s.core.len() >= 3 && inside_convex(&s.core, x))
+            if ps
+                .iter()
+                .any(|&x| t.core.len() >= 3 && inside_convex(&qi, x))
+                || qs
+                    .iter()
+                    .any(|&x| s.core.len() >= 3 && inside_convex(&s.core, x))
             {
                 continue;
             }
@@ -489,19 +634,31 @@ mod tests {
                 .fold(f64::INFINITY, f64::min);
             let mut out = Vec::new();
             sub_contacts((&s.core, s.radius), (&t.core, t.radius), d, 0.0, &mut out);
-            let deepest = out.iter().map(|c| c.delta).fold(f64::NEG_INFINITY, f64::max);
+            let deepest = out
+                .iter()
+                .map(|c| c.delta)
+                .fold(f64::NEG_INFINITY, f64::max);
             let expected = s.radius + t.radius - brute;
             if expected > 1e-3 {
                 assert!(!out.is_empty(), "a contact at overlap {expected}");
                 // Sampling finds the distance to within a 1/800 of an edge.
-                assert!((deepest - expected).abs() < 6e-3, "{deepest} against {expected}");
+                assert!(
+                    (deepest - expected).abs() < 6e-3,
+                    "{deepest} against {expected}"
+                );
                 checked += 1;
             } else if expected < -1e-3 {
                 assert!(out.is_empty(), "no contact at gap {}", -expected);
             }
             // Swapped: the same overlaps, normals and world points mirrored.
             let mut swapped = Vec::new();
-            sub_contacts((&t.core, t.radius), (&s.core, s.radius), [-d[0], -d[1]], 0.0, &mut swapped);
+            sub_contacts(
+                (&t.core, t.radius),
+                (&s.core, s.radius),
+                [-d[0], -d[1]],
+                0.0,
+                &mut swapped,
+            );
             assert_eq!(swapped.len(), out.len());
             for c in &out {
                 let world = c.arm;
@@ -515,5 +672,175 @@ mod tests {
             }
         }
         assert!(checked > 20, "only {checked} touching pairs");
+    }
+
+    use crate::law::hertz_cohesive::HertzCohesive;
+
+    #[test]
+    fn a_rod_lying_on_a_floor_carries_its_weight_on_two_points() {
+        // A rod of mass m on its flat side on a floor (a wall: a segment of sweep 0) at
+        // the overlap where each end carries half its weight, k δ^{3/2} = m g / 2.
+        let (m, g) = (0.785, 10.0);
+        let law = HertzCohesive::paper(m, g, 0.0, 0.5, 1.0);
+        let rod = Spheropolygon::rod(5.0, 1.0);
+        let delta = (0.5 * m * g / law.k_n).powf(2.0 / 3.0);
+        // The floor's segment relative to the rod's centre: d = r_rod − r_floor with the
+        // floor's "centre" at its middle, 0.5 − δ below the rod's axis.
+        let floor = [[-10.0, 0.0], [10.0, 0.0]];
+        let d = [0.0, 0.5 - delta];
+        let f = pair_force(
+            &law,
+            (&rod.core, 0.5),
+            (&floor, 0.0),
+            d,
+            ([0.0; 3], [0.0; 3]),
+            m,
+            &SubSprings::default(),
+            5e-6,
+        );
+        assert_eq!(f.contacts.len(), 2);
+        assert!((f.force[1] - m * g).abs() < 1e-12 * m * g, "{:?}", f.force);
+        assert!(f.force[0].abs() < 1e-15 && f.torque[0].abs() < 1e-12);
+        // On its tip (standing upright): one point carries it all.
+        let upright = Spheropolygon {
+            core: vec![[0.0, -2.0], [0.0, 2.0]],
+            radius: 0.5,
+        };
+        let delta = (m * g / law.k_n).powf(2.0 / 3.0);
+        let d = [0.0, 2.5 - delta];
+        let f = pair_force(
+            &law,
+            (&upright.core, 0.5),
+            (&floor, 0.0),
+            d,
+            ([0.0; 3], [0.0; 3]),
+            m,
+            &SubSprings::default(),
+            5e-6,
+        );
+        assert_eq!(f.contacts.len(), 1);
+        assert!((f.force[1] - m * g).abs() < 1e-12 * m * g);
+    }
+
+    #[test]
+    fn swapping_the_rods_gives_equal_and_opposite_forces() {
+        let law = HertzCohesive::paper(1.0, 10.0, 1e3, 0.4, 1.0);
+        let mut rng = Rng::new(3);
+        let mut touching = 0;
+        for _ in 0..300 {
+            let (s, t) = (random_shape(&mut rng), random_shape(&mut rng));
+            let reach = s.circumradius() + t.circumradius();
+            let angle = rng.uniform() * 2.0 * PI;
+            let dist = reach * (0.4 + 0.7 * rng.uniform());
+            let d = [dist * angle.cos(), dist * angle.sin()];
+            let vi = [
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            ];
+            let vj = [
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+                rng.range(-1.0, 1.0),
+            ];
+            let none = SubSprings::default();
+            let a = pair_force(
+                &law,
+                (&s.core, s.radius),
+                (&t.core, t.radius),
+                d,
+                (vi, vj),
+                0.5,
+                &none,
+                1e-3,
+            );
+            let b = pair_force(
+                &law,
+                (&t.core, t.radius),
+                (&s.core, s.radius),
+                [-d[0], -d[1]],
+                (vj, vi),
+                0.5,
+                &none,
+                1e-3,
+            );
+            let scale = 1.0 + a.force[0].abs() + a.force[1].abs();
+            assert!(
+                (a.force[0] + b.force[0]).abs() < 1e-9 * scale
+                    && (a.force[1] + b.force[1]).abs() < 1e-9 * scale
+            );
+            assert!((a.torque[0] - b.torque[1]).abs() < 1e-9 * scale * reach);
+            assert!((a.torque[1] - b.torque[0]).abs() < 1e-9 * scale * reach);
+            touching += usize::from(!a.contacts.is_empty());
+        }
+        assert!(touching > 30, "only {touching} pairs in range");
+    }
+
+    #[test]
+    fn each_sub_contact_keeps_its_own_spring_while_it_lasts() {
+        // Rod i slides along rod j below it (parallel, overlapping by 0.001): both
+        // sub-contacts' springs grow by v_t dt each step, and when i's end passes j's
+        // end the sub-contact there is gone with its spring; a new one starts at 0.
+        // No damping and no cap: the springs follow the kinematics alone.
+        let law = HertzCohesive {
+            mu: 1e6,
+            gamma_n: 0.0,
+            gamma_t: 0.0,
+            ..HertzCohesive::paper(1.0, 10.0, 0.0, 0.5, 1.0)
+        };
+        let rod = Spheropolygon::rod(3.0, 1.0);
+        let dt = 1e-3;
+        let v = 2.0;
+        let mut springs = SubSprings::default();
+        let mut x = -1.0;
+        let mut seen_keys = Vec::new();
+        // From x = −1 to 2.5: i's core [x − 1, x + 1] passes over j's [−1, 1].
+        for step in 0..1750 {
+            let d = [x, 0.999];
+            let f = pair_force(
+                &law,
+                (&rod.core, 0.5),
+                (&rod.core, 0.5),
+                d,
+                ([v, 0.0, 0.0], [0.0; 3]),
+                0.5,
+                &springs,
+                dt,
+            );
+            for (c, r) in &f.contacts {
+                let old = springs.get(c.key);
+                let fresh = !(0..springs.count).any(|k| springs.key[k] == c.key);
+                // t = (−n_z, n_x): v_t = −v n_z (−v where j lies straight below).
+                let step_xi = -v * c.n[1] * dt;
+                let expected = match (c.delta > 0.0, fresh) {
+                    // In the cohesive range but not touching: no spring.
+                    (false, _) => 0.0,
+                    (true, true) => step_xi,
+                    (true, false) => old + step_xi,
+                };
+                assert!(
+                    (r.history - expected).abs() < 1e-12,
+                    "step {step}, key {:x}: {} against {expected}, {c:?}, {r:?}, x = {x}",
+                    c.key,
+                    r.history
+                );
+                if !seen_keys.contains(&c.key) {
+                    seen_keys.push(c.key);
+                }
+            }
+            springs = f.springs;
+            x += v * dt;
+        }
+        // i passed over j and beyond its right end: each end over the other's side
+        // (vertex–edge), and the pairs of ends as they lined up (left ends, right ends,
+        // i's left on j's right).
+        seen_keys.sort();
+        let ends = [0x0, 0x100, 0x10000, 0x10100];
+        let lined_up = [VERTICES, VERTICES | 0x1, VERTICES | 0x101];
+        assert_eq!(
+            seen_keys,
+            [&ends[..], &lined_up[..]].concat(),
+            "{seen_keys:x?}"
+        );
     }
 }

@@ -172,7 +172,7 @@ impl Team {
                 return g;
             }
             spins = spins.wrapping_add(1);
-            if spins % 256 != 0 || start.elapsed() < SPIN {
+            if !spins.is_multiple_of(256) || start.elapsed() < SPIN {
                 std::hint::spin_loop();
                 continue;
             }
@@ -208,9 +208,11 @@ mod tests {
     #[test]
     fn a_job_started_inside_a_job_runs_elsewhere() {
         let inner = AtomicUsize::new(0);
-        run(2, &|_| run(2, &|_| {
-            inner.fetch_add(1, Ordering::Relaxed);
-        }));
+        run(2, &|_| {
+            run(2, &|_| {
+                inner.fetch_add(1, Ordering::Relaxed);
+            })
+        });
         assert_eq!(inner.load(Ordering::Relaxed), 4);
     }
 

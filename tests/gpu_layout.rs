@@ -237,15 +237,34 @@ fn each_kernel_binds_read_only_what_it_never_writes() {
     println!("{table}");
     // The contact kernel reads the particles and the lists, and writes only the
     // candidates' results and springs.
-    for name in ["state", "props", "corners", "walls", "contact_j", "contact_count"] {
-        assert_eq!(access(Kernel::ContactForcesOnly, name), "r", "contact_forces {name}");
+    for name in [
+        "state",
+        "props",
+        "corners",
+        "walls",
+        "contact_j",
+        "contact_count",
+    ] {
+        assert_eq!(
+            access(Kernel::ContactForcesOnly, name),
+            "r",
+            "contact_forces {name}"
+        );
     }
     for name in ["contact_ft", "touching", "hist_in"] {
-        assert_eq!(access(Kernel::ContactForcesOnly, name), "rw", "contact_forces {name}");
+        assert_eq!(
+            access(Kernel::ContactForcesOnly, name),
+            "rw",
+            "contact_forces {name}"
+        );
     }
     // It never touches the spring table or the particles on their way to a new order.
     for name in ["table", "state_next", "sorted"] {
-        assert_eq!(access(Kernel::ContactForcesOnly, name), "-", "contact_forces {name}");
+        assert_eq!(
+            access(Kernel::ContactForcesOnly, name),
+            "-",
+            "contact_forces {name}"
+        );
     }
     // The integrator writes the state and only reads the candidates' results.
     assert_eq!(access(Kernel::CorrectAhead, "state"), "rw");

@@ -204,7 +204,8 @@ fn kernel_module(parsed: &naga::Module, module: &str, entry: &str) -> KernelModu
         };
         let u = uses[handle];
         touched[k] = !u.is_empty();
-        writable[k] = u.intersects(GlobalUse::WRITE | GlobalUse::ATOMIC) || has_atomics(&BINDINGS[k]);
+        writable[k] =
+            u.intersects(GlobalUse::WRITE | GlobalUse::ATOMIC) || has_atomics(&BINDINGS[k]);
         if let naga::AddressSpace::Storage { access } = &mut var.space
             && !writable[k]
         {

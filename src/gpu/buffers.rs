@@ -172,7 +172,11 @@ impl Buffers {
     }
 
     /// The bind groups of the talus kernels, one per shape in `Pipelines::groups`.
-    pub(super) fn bind_groups(&self, dev: &wgpu::Device, pipelines: &Pipelines) -> Vec<wgpu::BindGroup> {
+    pub(super) fn bind_groups(
+        &self,
+        dev: &wgpu::Device,
+        pipelines: &Pipelines,
+    ) -> Vec<wgpu::BindGroup> {
         (pipelines.groups.iter())
             .map(|((g, shape), layout)| {
                 let entries: Vec<_> = (shape.iter())

@@ -131,7 +131,10 @@ mod tests {
         let out = sticky.evaluate(&input(-0.5e-4, 0.0, 1.0, 3e-3));
         assert_eq!((out.f_n, out.f_t, out.history), (-f_c, 0.0, 0.0));
         // Beyond it: nothing.
-        assert_eq!(sticky.evaluate(&input(-1.5e-4, 0.0, 1.0, 3e-3)), ContactOutput::default());
+        assert_eq!(
+            sticky.evaluate(&input(-1.5e-4, 0.0, 1.0, 3e-3)),
+            ContactOutput::default()
+        );
         // Cohesion's potential rises linearly across the range to zero at its end.
         let e = |d: f64| sticky.evaluate(&input(d, 0.0, 0.0, 0.0)).energy;
         assert!((e(-0.5e-4) + f_c * 0.5e-4).abs() < 1e-12);
@@ -168,7 +171,13 @@ mod tests {
             let mut t = 0.0;
             // Velocity Verlet on δ: m12 δ̈ = −F_N.
             let force = |d: f64, r: f64| {
-                let c = ContactInput { delta: d, delta_dot: r, m12, dt, ..Default::default() };
+                let c = ContactInput {
+                    delta: d,
+                    delta_dot: r,
+                    m12,
+                    dt,
+                    ..Default::default()
+                };
                 law.evaluate(&c).f_n
             };
             loop {
@@ -190,8 +199,14 @@ mod tests {
         // Elasticity, sec. 9).
         let delta_max = (5.0 * 0.5 * 0.1f64.powi(2) / (4.0 * 1e3)).powf(0.4);
         let hertz = 2.9432 * delta_max / 0.1;
-        assert!((t_c - hertz).abs() < 1e-3 * hertz, "contact time {t_c} against {hertz}");
+        assert!(
+            (t_c - hertz).abs() < 1e-3 * hertz,
+            "contact time {t_c} against {hertz}"
+        );
         let (e_damped, _) = run(300.0);
-        assert!(e_damped > 0.0 && e_damped < 0.99 * e, "damped restitution {e_damped}");
+        assert!(
+            e_damped > 0.0 && e_damped < 0.99 * e,
+            "damped restitution {e_damped}"
+        );
     }
 }
