@@ -210,6 +210,8 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
         }
         p.shape.push(corners);
     }
+    // Spheropolygon scenes write no checkpoints yet (scene validation): no sweeps here.
+    p.sweep = vec![0.0; n];
     let cap = d.u64().map_err(corrupt)? as usize;
     let mut springs = SpringTable {
         keys: Vec::with_capacity(cap),

@@ -11,12 +11,14 @@ use crate::contacts::{Pair, WALL_BASE};
 use crate::geometry::{
     Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent, wall_from,
 };
+use crate::law::hertz_cohesive::HertzCohesive;
 use crate::law::{ContactInput, ContactLaw, ContactOutput, Law};
 use crate::neighbours::{NeighbourList, id_pair};
 use crate::overlap::{
     AreaContact, disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall,
 };
 use crate::shape::RotatedCorners;
+use crate::spheropolygon::SubSprings;
 use crate::springs::pair_key;
 use crate::state::{Dof, Particles};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -247,6 +249,9 @@ pub struct Kick {
 pub struct CandidateResults {
     pub kicks: Vec<Kick>,
     pub history: Vec<f64>,
+    /// Spheropolygon pairs (law hertz_cohesive): each candidate's sub-contact springs
+    /// (empty under the other laws).
+    pub sub_history: Vec<SubSprings>,
     /// Every candidate's contact, or None; empty when the step did not record.
     pub contacts: Vec<Option<ContactForce>>,
     /// The first candidate (by pair of ids) whose contact diverges (`diverges`), with
@@ -271,7 +276,146 @@ pub fn candidate_forces(
         ContactLaw::SpringDashpot(l) => candidates_with(s, l, c, out),
         ContactLaw::OverlapArea(l) => candidates_with(s, l, c, out),
         ContactLaw::Continuous(l) => candidates_with(s, l, c, out),
+        ContactLaw::HertzCohesive(l) => spheropolygon_candidates(s, l, c, out),
     }
+}
+
+/// The candidates of a spheropolygon scene (law hertz_cohesive, SPEC 2.4): each pair's
+/// force is the sum over its sub-contacts (`spheropolygon::pair_force`), each with its
+/// spring from the list's slot (`NeighbourList::sub_history`). A disk is a point core
+/// swept by its radius; a wall a segment of sweep 0. When recording, a pair is reported
+/// as one contact: its total force at its deepest sub-contact's point and normal.
+fn spheropolygon_candidates(
+    s: &StepState,
+    law: &HertzCohesive,
+    (list, ids, max_overlap, record): (&NeighbourList, &[u32], f64, bool),
+    out: &mut CandidateResults,
+) {
+    let n = list.pairs.len();
+    out.kicks.resize(n, Kick::default());
+    out.sub_history.resize(n, SubSprings::default());
+    // The pair slot's own history is unused: its springs are the sub-contacts'.
+    out.history.clear();
+    out.history.resize(n, 0.0);
+    out.contacts.clear();
+    if record {
+        out.contacts.resize(n, None);
+    }
+    let first = AtomicU64::new(u64::MAX);
+    let watch = Watch {
+        particles: s.particles,
+        ids,
+        max_overlap,
+        first: &first,
+    };
+    let springs = if list.sub_history.len() == n {
+        &list.sub_history[..]
+    } else {
+        &[]
+    };
+    let evaluate = |k: usize| spheropolygon_candidate(s, law, list.pairs[k], springs.get(k));
+    let contacts = std::sync::Mutex::new(Vec::new());
+    crate::parallel::for_each2(&mut out.kicks, &mut out.sub_history, |k, kick, sub| {
+        let (c, new) = evaluate(k);
+        *sub = new;
+        let mut h = 0.0;
+        let c = settle(&watch, list.pairs[k], c.map(|c| (c, 0.0)), kick, &mut h);
+        if record && c.is_some() {
+            contacts
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push((k, c));
+        }
+    });
+    for (k, c) in contacts.into_inner().unwrap_or_else(|e| e.into_inner()) {
+        out.contacts[k] = c;
+    }
+    let key = first.into_inner();
+    out.diverging = (key != u64::MAX).then(|| {
+        let k = (list.pairs.iter())
+            .position(|&p| pair_key(id_pair(p, ids)) == key)
+            .expect("the diverging pair is a candidate");
+        let c = evaluate(k).0.expect("a diverging candidate is a contact");
+        (k, c)
+    });
+}
+
+/// One spheropolygon candidate: its contact (None when no sub-contact is in range) and
+/// its sub-contacts' updated springs.
+fn spheropolygon_candidate(
+    s: &StepState,
+    law: &HertzCohesive,
+    pair: Pair,
+    springs: Option<&SubSprings>,
+) -> (Option<ContactForce>, SubSprings) {
+    let p = s.particles;
+    let i = pair.i as usize;
+    const POINT: [[f64; 2]; 1] = [[0.0, 0.0]];
+    // A particle's core, turned, and its sweep (a disk: a point swept by its radius).
+    let core = |k: usize| -> (&[[f64; 2]], f64) {
+        if p.is_swept(k) {
+            (s.corners.of(k), p.sweep[k])
+        } else {
+            (&POINT, p.radius[k])
+        }
+    };
+    let mi = p.mass[i];
+    let none = SubSprings::default();
+    let springs = springs.unwrap_or(&none);
+    let f = if pair.is_wall() {
+        let w = wall_from(&s.walls[(pair.j - WALL_BASE) as usize], p.position(i));
+        let seg = [w.a, w.b];
+        let motion = (s.velocity[i], [0.0; 3]);
+        crate::spheropolygon::pair_force(
+            law,
+            core(i),
+            (&seg, 0.0),
+            [0.0; 2],
+            motion,
+            (mi, mi),
+            springs,
+            s.dt,
+        )
+    } else {
+        let j = pair.j as usize;
+        let mj = p.mass[j];
+        let m12 = mi * mj / (mi + mj);
+        let d = offset(p, i, j);
+        let motion = (s.velocity[i], s.velocity[j]);
+        crate::spheropolygon::pair_force(
+            law,
+            core(i),
+            core(j),
+            d,
+            motion,
+            (m12, 2.0 * m12),
+            springs,
+            s.dt,
+        )
+    };
+    let Some(deepest) = f
+        .contacts
+        .iter()
+        .map(|(c, _)| c)
+        .max_by(|a, b| a.delta.total_cmp(&b.delta))
+    else {
+        return (None, f.springs);
+    };
+    let t = tangent(deepest.n);
+    let pos = p.position(i);
+    let c = ContactForce {
+        force: f.force,
+        // ContactForce's second torque is about j's centre, arm' × F (on j: minus that).
+        torque: [f.torque[0], -f.torque[1]],
+        point: [pos[0] + deepest.arm[0], pos[1] + deepest.arm[1]],
+        arm: deepest.arm,
+        n: deepest.n,
+        f_n: f.force[0] * deepest.n[0] + f.force[1] * deepest.n[1],
+        f_t: f.force[0] * t[0] + f.force[1] * t[1],
+        overlap: deepest.delta,
+        energy: f.contacts.iter().map(|(_, r)| r.energy).sum(),
+    };
+    (Some(c), f.springs)
 }
 
 fn candidates_with<L: Law>(

@@ -50,6 +50,9 @@ pub struct NeighbourList {
     pub down: Vec<u32>,
     /// Each candidate's tangential history after the last completed step (0: no contact).
     pub history: Vec<f64>,
+    /// Spheropolygon scenes (law hertz_cohesive): each candidate's sub-contact springs,
+    /// moved with the slots like `history` (empty under the other laws).
+    pub sub_history: Vec<crate::spheropolygon::SubSprings>,
     /// Positions at the last rebuild, and which particles were active then.
     at: Vec<Dof>,
     active: Vec<bool>,
@@ -137,6 +140,17 @@ impl NeighbourList {
             skin,
         };
         list_candidates(&s, &mut pairs, &mut start);
+        if self.is_built() && self.sub_history.len() == self.pairs.len() {
+            let origin = origins(&self.pairs, &pairs, ids);
+            let old = std::mem::take(&mut self.sub_history);
+            self.sub_history = (origin.iter())
+                .map(|o| o.map_or_else(Default::default, |k| old[k]))
+                .collect();
+        } else {
+            // The first list, or no spheropolygons: springs start afresh (their scenes
+            // write no checkpoints to start from yet).
+            self.sub_history.clear();
+        }
         let history = if self.is_built() {
             carry_over(&self.pairs, &self.history, &pairs, ids)
         } else {
@@ -203,6 +217,9 @@ impl NeighbourList {
         }
         start.push(pairs.len() as u32);
         self.history = gather(&self.history, &from);
+        if self.sub_history.len() == self.pairs.len() {
+            self.sub_history = gather(&self.sub_history, &from);
+        }
         down_lists(&pairs, &start, ids, &mut self.down_start, &mut self.down);
         self.pairs = pairs;
         self.start = start;
@@ -350,6 +367,21 @@ fn candidates_of(s: &Search, i: usize, out: &mut Vec<Pair>) {
             });
         }
     }
+}
+
+/// For each new candidate, the index of the same pair in the old list (None: a new
+/// pair): the merge of `carry_over`, for arrays of any type.
+fn origins(old: &[Pair], new: &[Pair], ids: &[u32]) -> Vec<Option<usize>> {
+    let key = |p: &Pair| (p.i, partner_key(*p, ids));
+    let mut out = Vec::with_capacity(new.len());
+    let mut k = 0;
+    for p in new {
+        while k < old.len() && key(&old[k]) < key(p) {
+            k += 1;
+        }
+        out.push((k < old.len() && old[k] == *p).then_some(k));
+    }
+    out
 }
 
 /// Each new candidate's history from the old list: both are in the same memory order

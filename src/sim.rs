@@ -414,11 +414,15 @@ impl Simulation {
         if !results {
             c.kicks.clear();
             c.history.clear();
+            c.sub_history.clear();
             c.contacts.clear();
             c.diverging = None;
         } else if c.kicks.len() == from.len() {
             c.kicks = gather(&c.kicks, &from);
             c.history = gather(&c.history, &from);
+            if c.sub_history.len() == from.len() {
+                c.sub_history = gather(&c.sub_history, &from);
+            }
         }
         if c.contacts.len() == from.len() {
             c.contacts = gather(&c.contacts, &from);
@@ -556,6 +560,10 @@ impl Simulation {
         self.check_divergence()?;
         // The candidates' updated springs become the list's.
         std::mem::swap(&mut self.neighbours.history, &mut self.candidates.history);
+        std::mem::swap(
+            &mut self.neighbours.sub_history,
+            &mut self.candidates.sub_history,
+        );
         self.committed = true;
         if gear {
             // Forces were evaluated at the predicted state, i.e. at time t + dt.

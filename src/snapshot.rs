@@ -175,6 +175,14 @@ pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBu
     };
     b.push("corners", "x", len, body(0));
     b.push("corners", "z", len, body(1));
+    // Spheropolygons (rods): the sweep radius about the core the corners give (0 for
+    // disks and polygons).
+    b.push(
+        "particles",
+        "sweep",
+        len,
+        Column::F64(ids.iter().map(|&i| p.sweep[i]).collect()),
+    );
     let c = &sim.contacts;
     let pairs = &sim.pairs;
     let cf = |g: &dyn Fn(usize) -> f64| Column::F64((0..c.len()).map(g).collect());

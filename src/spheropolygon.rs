@@ -145,6 +145,41 @@ impl Spheropolygon {
         m.polar - m.area * dot(c, c)
     }
 
+    /// The outline of the swept shape in the body frame, counter-clockwise: the core's
+    /// edges pushed out by r, joined by arcs of `per_arc` + 1 points about the corners
+    /// (pictures and files; the mass properties are exact, `moments`).
+    pub fn outline(&self, per_arc: usize) -> Vec<P2> {
+        let (v, r) = (&self.core, self.radius);
+        let n = v.len();
+        if n == 1 {
+            return (0..4 * per_arc)
+                .map(|k| {
+                    let a = 2.0 * PI * k as f64 / (4 * per_arc) as f64;
+                    [v[0][0] + r * a.cos(), v[0][1] + r * a.sin()]
+                })
+                .collect();
+        }
+        let normal = |k: usize| {
+            let e = sub(v[(k + 1) % n], v[k]);
+            let l = norm(e);
+            [e[1] / l, -e[0] / l]
+        };
+        let mut out = Vec::with_capacity(n * (per_arc + 1));
+        for k in 0..n {
+            let b = v[(k + 1) % n];
+            let (nk, nn) = (normal(k), normal((k + 1) % n));
+            let mut alpha = cross(nk, nn).atan2(dot(nk, nn));
+            if alpha <= 0.0 {
+                alpha += 2.0 * PI;
+            }
+            for m in 0..=per_arc {
+                let u = rotate(nk, alpha * m as f64 / per_arc as f64);
+                out.push([b[0] + r * u[0], b[1] + r * u[1]]);
+            }
+        }
+        out
+    }
+
     /// The distance from a point to the core (0 inside a polygon core).
     pub fn core_distance(&self, p: P2) -> f64 {
         let v = &self.core;
@@ -353,7 +388,8 @@ pub struct PairForce {
 pub type Motion = [f64; 3];
 
 /// The force between spheropolygons i and j (`p`, `q`: their turned cores and sweep
-/// radii; `d` = r_i − r_j; `m12` the reduced mass, the mass of i against a wall) under
+/// radii; `d` = r_i − r_j; `m12` the reduced mass, the mass of i against a wall, and
+/// `mass` the contact's mass scale for the cohesion, `ContactInput::mass`) under
 /// paper 004's law, each sub-contact with its own spring from `springs` (SPEC 2.4). A
 /// wall is a spheropolygon of sweep radius 0 that does not move.
 #[allow(clippy::too_many_arguments)]
@@ -363,7 +399,7 @@ pub fn pair_force(
     q: (&[P2], f64),
     d: P2,
     (vi, vj): (Motion, Motion),
-    m12: f64,
+    (m12, mass): (f64, f64),
     springs: &SubSprings,
     dt: f64,
 ) -> PairForce {
@@ -385,6 +421,7 @@ pub fn pair_force(
             delta_dot: -dot(v12, c.n),
             v_t: dot(v12, t),
             m12,
+            mass,
             history,
             dt,
             ..Default::default()
@@ -507,6 +544,19 @@ mod tests {
         assert!((c[0] - fx / a).abs() < 2e-3 && (c[1] - fz / a).abs() < 2e-3);
         let jc = j - a * ((fx / a).powi(2) + (fz / a).powi(2));
         assert!((s.polar_moment() - jc).abs() < 3e-3 * jc);
+    }
+
+    #[test]
+    fn the_outline_of_a_rod_is_its_stadium() {
+        let rod = Spheropolygon::rod(4.0, 1.0);
+        let o = rod.outline(32);
+        // Every point lies on the surface, the polygon goes counter-clockwise, and its
+        // area approaches the stadium's from below.
+        for p in &o {
+            assert!((rod.core_distance(*p) - 0.5).abs() < 1e-12);
+        }
+        let a = crate::shape::area(&o);
+        assert!(a > 0.0 && a < rod.area() && a > 0.999 * rod.area(), "{a}");
     }
 
     #[test]
@@ -681,7 +731,7 @@ mod tests {
         // A rod of mass m on its flat side on a floor (a wall: a segment of sweep 0) at
         // the overlap where each end carries half its weight, k δ^{3/2} = m g / 2.
         let (m, g) = (0.785, 10.0);
-        let law = HertzCohesive::paper(m, g, 0.0, 0.5, 1.0);
+        let law = HertzCohesive::paper(g, 0.0, 0.5, 1.0);
         let rod = Spheropolygon::rod(5.0, 1.0);
         let delta = (0.5 * m * g / law.k_n).powf(2.0 / 3.0);
         // The floor's segment relative to the rod's centre: d = r_rod − r_floor with the
@@ -694,7 +744,7 @@ mod tests {
             (&floor, 0.0),
             d,
             ([0.0; 3], [0.0; 3]),
-            m,
+            (m, m),
             &SubSprings::default(),
             5e-6,
         );
@@ -714,7 +764,7 @@ mod tests {
             (&floor, 0.0),
             d,
             ([0.0; 3], [0.0; 3]),
-            m,
+            (m, m),
             &SubSprings::default(),
             5e-6,
         );
@@ -724,7 +774,7 @@ mod tests {
 
     #[test]
     fn swapping_the_rods_gives_equal_and_opposite_forces() {
-        let law = HertzCohesive::paper(1.0, 10.0, 1e3, 0.4, 1.0);
+        let law = HertzCohesive::paper(10.0, 1e3, 0.4, 1.0);
         let mut rng = Rng::new(3);
         let mut touching = 0;
         for _ in 0..300 {
@@ -750,7 +800,7 @@ mod tests {
                 (&t.core, t.radius),
                 d,
                 (vi, vj),
-                0.5,
+                (0.5, 1.0),
                 &none,
                 1e-3,
             );
@@ -760,7 +810,7 @@ mod tests {
                 (&s.core, s.radius),
                 [-d[0], -d[1]],
                 (vj, vi),
-                0.5,
+                (0.5, 1.0),
                 &none,
                 1e-3,
             );
@@ -786,7 +836,7 @@ mod tests {
             mu: 1e6,
             gamma_n: 0.0,
             gamma_t: 0.0,
-            ..HertzCohesive::paper(1.0, 10.0, 0.0, 0.5, 1.0)
+            ..HertzCohesive::paper(10.0, 0.0, 0.5, 1.0)
         };
         let rod = Spheropolygon::rod(3.0, 1.0);
         let dt = 1e-3;
@@ -803,7 +853,7 @@ mod tests {
                 (&rod.core, 0.5),
                 d,
                 ([v, 0.0, 0.0], [0.0; 3]),
-                0.5,
+                (0.5, 1.0),
                 &springs,
                 dt,
             );

@@ -28,6 +28,9 @@ pub struct Particles {
     /// Polygon corners in the body frame (counter-clockwise, centroid at the origin);
     /// empty for a disk. `radius` is then the circumscribed radius.
     pub shape: Vec<Vec<P2>>,
+    /// A spheropolygon's sweep radius (src/spheropolygon.rs: `shape` is then its core,
+    /// two corners for a rod); 0 for disks and polygons.
+    pub sweep: Vec<f64>,
 }
 
 /// A new particle before it joins the state.
@@ -44,6 +47,8 @@ pub struct NewParticle {
     pub material: u32,
     /// Polygon corners in the body frame (see `shape`); empty for a disk.
     pub corners: Vec<P2>,
+    /// Sweep radius of a spheropolygon whose core is `corners` (0: a disk or polygon).
+    pub sweep: f64,
 }
 
 impl Particles {
@@ -60,7 +65,15 @@ impl Particles {
     /// actual area, density · thickness · ∫ r² dA about the centroid.
     pub fn push_particle(&mut self, d: &NewParticle, density: f64, thickness: f64, dt: f64) -> u32 {
         let id = self.len() as u32;
-        let (mass, inertia) = if d.corners.is_empty() {
+        let (mass, inertia) = if d.sweep > 0.0 {
+            // A spheropolygon: the exact area and moment of the swept shape.
+            let s = crate::spheropolygon::Spheropolygon {
+                core: d.corners.clone(),
+                radius: d.sweep,
+            };
+            let rho = density * thickness;
+            (rho * s.area(), rho * s.polar_moment())
+        } else if d.corners.is_empty() {
             let mass = density * std::f64::consts::PI * d.radius * d.radius * thickness;
             (mass, 0.5 * mass * d.radius * d.radius)
         } else {
@@ -86,6 +99,7 @@ impl Particles {
         self.active.push(true);
         self.material.push(d.material);
         self.shape.push(d.corners.clone());
+        self.sweep.push(d.sweep);
         id
     }
 
@@ -115,6 +129,11 @@ impl Particles {
         !self.shape[i].is_empty()
     }
 
+    /// Whether particle i is a spheropolygon (a rod).
+    pub fn is_swept(&self, i: usize) -> bool {
+        self.sweep[i] > 0.0
+    }
+
     /// Puts the particles in a new memory order: `order[new] = old` index (a
     /// permutation of 0..len).
     pub fn permute(&mut self, order: &[u32]) {
@@ -129,6 +148,7 @@ impl Particles {
         self.fixed = gather(&self.fixed, order);
         self.active = gather(&self.active, order);
         self.material = gather(&self.material, order);
+        self.sweep = gather(&self.sweep, order);
         let mut shape = std::mem::take(&mut self.shape);
         self.shape = order
             .iter()

@@ -134,11 +134,7 @@ fn wgsl_laws_match_their_rust_twins() {
             }
             // f32 and f64 may take different sides of the Coulomb cap (stick or slip)
             // only where the trial force is at the cap: then |f_t| = μ f_n on both.
-            let mu = match &law {
-                ContactLaw::SpringDashpot(l) => l.mu,
-                ContactLaw::OverlapArea(l) => l.mu,
-                ContactLaw::Continuous(l) => l.mu,
-            };
+            let mu = law.mu();
             let at_cap = |v: &[f64; 4]| (v[1].abs() - mu * v[0].abs()).abs() <= 1e-3 * scale[1];
             if !(at_cap(c) && at_cap(g)) {
                 off_boundary += 1;

@@ -35,6 +35,7 @@ fn packing(seed: u64, n: usize, polygons: bool) -> Particles {
             fixed_rotation: false,
             material: 0,
             corners,
+            sweep: 0.0,
         };
         p.push_particle(&d, 1.0, 1.0, 1e-3);
     }

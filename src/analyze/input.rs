@@ -20,7 +20,8 @@ pub struct Grain {
     pub fixed: bool,
     /// Area of the actual shape (per unit thickness).
     pub area: f64,
-    /// World corners (empty for a disk).
+    /// World corners (empty for a disk; a rod's outline, its core swept by its sweep
+    /// radius, for pictures and bounds).
     pub corners: Vec<P2>,
 }
 
@@ -164,6 +165,8 @@ pub fn load(path: &Path, g: Option<f64>) -> Result<Input, String> {
         s.f64("corners.x").unwrap_or(&[]),
         s.f64("corners.z").unwrap_or(&[]),
     );
+    // Spheropolygons (rods) since stop 27; older snapshots have none.
+    let sweeps = s.f64("particles.sweep").unwrap_or(&[]);
     let fixed: Vec<bool> = match s.columns.get("particles.fixed") {
         Some(snapshot::Column::U8(v)) => v.iter().map(|&b| b != 0).collect(),
         _ => vec![false; ids.len()],
@@ -180,7 +183,16 @@ pub fn load(path: &Path, g: Option<f64>) -> Result<Input, String> {
         }
         next += n;
         let mut corners = Vec::new();
-        let a = if n >= 3 {
+        let sweep = sweeps.get(k).copied().unwrap_or(0.0);
+        let a = if sweep > 0.0 {
+            // A rod: its exact area, and its outline as the corners to draw and bound.
+            let s = crate::spheropolygon::Spheropolygon {
+                core: body.clone(),
+                radius: sweep,
+            };
+            world(&s.outline(8), [xs[k], zs[k]], th[k], &mut corners);
+            s.area()
+        } else if n >= 3 {
             world(&body, [xs[k], zs[k]], th[k], &mut corners);
             area(&body)
         } else {

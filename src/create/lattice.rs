@@ -80,6 +80,7 @@ pub fn pile(p: &LatticePile, material: u32, rng: &mut Rng) -> Vec<NewParticle> {
                 fixed_rotation: false,
                 material,
                 corners,
+                sweep: 0.0,
             });
         }
     }

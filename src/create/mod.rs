@@ -89,6 +89,7 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
                         fixed_rotation: false,
                         material,
                         corners,
+                        sweep: 0.0,
                     };
                     push(scene, &mut particles, &d);
                 }
@@ -96,7 +97,16 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
             Creation::List(l) => {
                 let material = material_index(scene, &l.material);
                 for p in &l.particles {
-                    let (radius, corners) = regular_shape(l.polygon.as_ref(), p.diameter, false);
+                    let (mut radius, mut corners) =
+                        regular_shape(l.polygon.as_ref(), p.diameter, false);
+                    let mut sweep = 0.0;
+                    if let Some(rod) = &l.rod {
+                        // Paper 004's rod: width `diameter`, length `aspect` widths.
+                        let s = crate::spheropolygon::Spheropolygon::rod(rod.aspect, p.diameter);
+                        radius = s.circumradius();
+                        sweep = s.radius;
+                        corners = s.core;
+                    }
                     let d = NewParticle {
                         position: p.position,
                         theta: p.theta,
@@ -107,6 +117,7 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
                         fixed_rotation: p.fixed_rotation,
                         material,
                         corners,
+                        sweep,
                     };
                     push(scene, &mut particles, &d);
                 }

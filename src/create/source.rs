@@ -182,6 +182,7 @@ pub fn particle_at(
         fixed_rotation: false,
         material,
         corners,
+        sweep: 0.0,
     }
 }
 

@@ -192,6 +192,12 @@ impl GpuSimulation {
             sim,
             device: device_state,
         } = ckpt;
+        if matches!(sim.law, ContactLaw::HertzCohesive(_)) {
+            return Err(GpuError::Unsupported(
+                "spheropolygons (law hertz_cohesive: rods, cohesion) are not on the GPU path yet"
+                    .into(),
+            ));
+        }
         let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);
         if !point_sources.is_empty() && !layered_specs.is_empty() {
             return Err(GpuError::Unsupported(

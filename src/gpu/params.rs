@@ -28,6 +28,11 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             p.gamma_t = l.eta_t as f32;
             p.clamp = 1;
         }
+        // Refused before a run (`GpuSimulation::resume_with_gpu`); tests of laws.wgsl
+        // never ask for it.
+        ContactLaw::HertzCohesive(_) => {
+            unreachable!("the GPU path refuses law hertz_cohesive before a run")
+        }
         ContactLaw::Continuous(c) => {
             p.law = LAW_CONTINUOUS;
             match c.elastic {

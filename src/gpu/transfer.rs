@@ -183,6 +183,8 @@ pub fn from_device(
         let [start, count] = pr.shape;
         p.shape
             .push(corner_table[start as usize..(start + count) as usize].to_vec());
+        // The GPU path refuses spheropolygons (`GpuSimulation::with_gpu`).
+        p.sweep.push(0.0);
     }
     p
 }

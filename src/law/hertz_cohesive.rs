@@ -31,15 +31,23 @@ pub struct HertzCohesive {
     pub gamma_n: f64,
     pub gamma_t: f64,
     pub mu: f64,
-    /// The cohesive force F_c = Bo m g and its range d_c (a gap, in length units).
-    pub f_c: f64,
+    /// Bo g: the cohesive force is F_c = Bo g m with m the contact's mass scale
+    /// (`ContactInput::mass`: a particle's mass for two equal ones, the particle's for a
+    /// wall), i.e. Bo = F_c / (m g) (paper 004 sec. 2).
+    pub bond_g: f64,
+    /// The cohesion range d_c (a gap, in length units).
     pub d_c: f64,
 }
 
+/// The largest cohesion range against the pair's σ = r_i + r_j of circumscribed radii:
+/// the neighbour search takes circles within (1 + RANGE_MARGIN) σ, so d_c is limited to
+/// that margin of the smallest particle (validated).
+pub const RANGE_MARGIN: f64 = 1e-3;
+
 impl HertzCohesive {
-    /// Paper 004's values for particles of mass m under gravity g, Bond number `bond`,
-    /// friction μ and width w (d_c = 10⁻⁴ w).
-    pub fn paper(m: f64, g: f64, bond: f64, mu: f64, width: f64) -> Self {
+    /// Paper 004's values under gravity g, Bond number `bond`, friction μ and width w
+    /// (d_c = 10⁻⁴ w).
+    pub fn paper(g: f64, bond: f64, mu: f64, width: f64) -> Self {
         let k_n = 1e3;
         let gamma_t = 100.0;
         HertzCohesive {
@@ -48,9 +56,45 @@ impl HertzCohesive {
             gamma_n: 3.0 * gamma_t,
             gamma_t,
             mu,
-            f_c: bond * m * g,
+            bond_g: bond * g,
             d_c: 1e-4 * width,
         }
+    }
+
+    /// The scene's `contact` block; g = |gravity|.
+    pub fn from_spec(
+        s: &crate::scene::HertzCohesiveSpec,
+        g: f64,
+    ) -> Result<Self, crate::scene::SceneError> {
+        use crate::scene::SceneError;
+        let check = |key: &str, v: f64, positive: bool| {
+            if !v.is_finite() || v < 0.0 || (positive && v == 0.0) {
+                let what = if positive {
+                    "a positive"
+                } else {
+                    "a non-negative"
+                };
+                return Err(SceneError::invalid(
+                    format!("contact.{key}"),
+                    format!("must be {what} number, got {v}"),
+                ));
+            }
+            Ok(v)
+        };
+        Ok(HertzCohesive {
+            k_n: check("k_n", s.k_n, true)?,
+            k_t: check("k_t", s.k_t, false)?,
+            gamma_n: check("gamma_n", s.gamma_n, false)?,
+            gamma_t: check("gamma_t", s.gamma_t, false)?,
+            mu: check("mu", s.mu, false)?,
+            bond_g: check("bond", s.bond, false)? * g,
+            d_c: check("d_c", s.d_c, false)?,
+        })
+    }
+
+    /// The cohesive force of a contact of mass scale m.
+    pub fn cohesion(&self, mass: f64) -> f64 {
+        self.bond_g * mass
     }
 
     /// Forces on particle 1 along n and t for a sub-contact of overlap δ (negative: a gap).
@@ -67,6 +111,7 @@ impl HertzCohesive {
         } else {
             (0.0, 0.0)
         };
+        let f_c = self.cohesion(c.mass);
         let (f_t, history) = if touching {
             coulomb_spring(
                 c.history,
@@ -81,11 +126,11 @@ impl HertzCohesive {
             (0.0, 0.0)
         };
         ContactOutput {
-            f_n: f_rep - self.f_c,
+            f_n: f_rep - f_c,
             f_t,
             history,
             // The cohesive pull's potential, −F_c (δ + d_c), counts with the rest.
-            energy: elastic + spring_energy(self.k_t, history) - self.f_c * (delta + self.d_c),
+            energy: elastic + spring_energy(self.k_t, history) - f_c * (delta + self.d_c),
         }
     }
 }
@@ -100,6 +145,7 @@ mod tests {
             delta_dot,
             v_t,
             m12: 0.5,
+            mass: 1.0,
             history,
             dt: 5e-6,
             ..Default::default()
@@ -109,7 +155,7 @@ mod tests {
     #[test]
     fn a_static_overlap_carries_k_delta_to_the_three_halves() {
         // The overlap that carries a weight m g: k δ^{3/2} = m g.
-        let law = HertzCohesive::paper(0.785, 10.0, 0.0, 0.5, 1.0);
+        let law = HertzCohesive::paper(10.0, 0.0, 0.5, 1.0);
         let w = 0.785 * 10.0;
         let delta = (w / law.k_n).powf(2.0 / 3.0);
         let out = law.evaluate(&input(delta, 0.0, 0.0, 0.0));
@@ -121,10 +167,11 @@ mod tests {
 
     #[test]
     fn damping_never_pulls_but_cohesion_does() {
-        let law = HertzCohesive::paper(1.0, 10.0, 0.0, 0.5, 1.0);
+        let law = HertzCohesive::paper(10.0, 0.0, 0.5, 1.0);
         // Separating fast: the damped force would be negative; clamped at zero.
         assert_eq!(law.evaluate(&input(1e-4, -10.0, 0.0, 0.0)).f_n, 0.0);
-        let sticky = HertzCohesive::paper(1.0, 10.0, 1e3, 0.5, 1.0);
+        let sticky = HertzCohesive::paper(10.0, 1e3, 0.5, 1.0);
+        // Bo = 10³ for a contact of mass scale 1 under g = 10.
         let f_c = 1e3 * 10.0;
         assert_eq!(sticky.evaluate(&input(1e-4, -10.0, 0.0, 0.0)).f_n, -f_c);
         // Within the range d_c = 1e-4 of a gap: pulled, no friction, no spring.
@@ -142,7 +189,7 @@ mod tests {
 
     #[test]
     fn the_tangential_spring_sticks_below_the_cap_and_slides_at_mu_times_the_repulsion() {
-        let law = HertzCohesive::paper(1.0, 10.0, 1e3, 0.5, 1.0);
+        let law = HertzCohesive::paper(10.0, 1e3, 0.5, 1.0);
         let delta = 1e-3;
         let f_rep = law.k_n * delta * delta.sqrt();
         // A small spring sticks: −k_t ξ − γ_t m12 v_t.
@@ -164,7 +211,7 @@ mod tests {
         let run = |gamma_n: f64| {
             let law = HertzCohesive {
                 gamma_n,
-                ..HertzCohesive::paper(1.0, 10.0, 0.0, 0.0, 1.0)
+                ..HertzCohesive::paper(10.0, 0.0, 0.0, 1.0)
             };
             let (m12, dt) = (0.5, 1e-7);
             let (mut delta, mut rate) = (0.0, 0.1);

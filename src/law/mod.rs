@@ -97,6 +97,9 @@ pub enum ContactLaw {
     SpringDashpot(spring_dashpot::SpringDashpot),
     OverlapArea(overlap_area::OverlapArea),
     Continuous(continuous::Continuous),
+    /// Spheropolygons (rods, and disks as point cores): paper 004's law per sub-contact
+    /// (src/spheropolygon.rs).
+    HertzCohesive(hertz_cohesive::HertzCohesive),
 }
 
 impl ContactLaw {
@@ -116,6 +119,9 @@ impl ContactLaw {
             ContactSpec::HookeEquivalent(s) => Ok(Self::Continuous(
                 continuous::Continuous::from_hooke_spec(s, g)?,
             )),
+            ContactSpec::HertzCohesive(s) => Ok(Self::HertzCohesive(
+                hertz_cohesive::HertzCohesive::from_spec(s, g)?,
+            )),
         }
     }
 
@@ -124,6 +130,8 @@ impl ContactLaw {
         match self {
             Self::SpringDashpot(_) | Self::OverlapArea(_) => 1.0,
             Self::Continuous(c) => c.range_factor(),
+            // Circumscribed circles within d_c (validated below this margin of σ).
+            Self::HertzCohesive(_) => 1.0 + hertz_cohesive::RANGE_MARGIN,
         }
     }
 
@@ -138,6 +146,7 @@ impl ContactLaw {
             Self::SpringDashpot(l) => l.evaluate(c),
             Self::OverlapArea(l) => l.evaluate(c),
             Self::Continuous(l) => l.evaluate(c),
+            Self::HertzCohesive(l) => l.evaluate(c),
         }
     }
 
@@ -148,6 +157,8 @@ impl ContactLaw {
             Self::SpringDashpot(l) => l.omega0_squared(m12, sigma),
             Self::OverlapArea(l) => l.omega0_squared(m12),
             Self::Continuous(l) => l.omega0_squared(m12, sigma),
+            // Hertz's stiffness dF/dδ = 3/2 k δ^{1/2} at an overlap of 1 % of σ.
+            Self::HertzCohesive(l) => 1.5 * l.k_n * (0.01 * sigma).sqrt() / m12,
         }
     }
 
@@ -156,6 +167,7 @@ impl ContactLaw {
             Self::SpringDashpot(l) => l.mu,
             Self::OverlapArea(l) => l.mu,
             Self::Continuous(l) => l.mu,
+            Self::HertzCohesive(l) => l.mu,
         }
     }
 }

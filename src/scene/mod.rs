@@ -110,6 +110,7 @@ fn refine_tagged_error(root: &serde_json::Value, path: &str) -> Option<SceneErro
             "spring_dashpot" => inner::<SpringDashpotSpec>(block, "law", path),
             "continuous" => inner::<ContinuousSpec>(block, "law", path),
             "hooke_equivalent" => inner::<HookeEquivalentSpec>(block, "law", path),
+            "hertz_cohesive" => inner::<HertzCohesiveSpec>(block, "law", path),
             _ => None,
         };
     }

@@ -124,6 +124,43 @@ pub enum ContactSpec {
     OverlapArea(OverlapAreaSpec),
     Continuous(ContinuousSpec),
     HookeEquivalent(HookeEquivalentSpec),
+    HertzCohesive(HertzCohesiveSpec),
+}
+
+/// Paper 004's law for spheropolygons (rods and disks): Hertz with viscous damping, a
+/// Coulomb-capped tangential spring, and a constant cohesive pull within d_c (SPEC 2.4,
+/// src/law/hertz_cohesive.rs).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HertzCohesiveSpec {
+    /// Hertz stiffness k^N in F = k^N δ^{3/2} (paper 004: 10³ N/m^{3/2}).
+    pub k_n: f64,
+    /// Tangential spring k^T (paper 004: 0.1 k^N).
+    #[serde(default)]
+    pub k_t: f64,
+    /// Damping rates γ^N, γ^T (1/time), multiplied by the reduced mass (paper 004: 300
+    /// and 100 s⁻¹).
+    #[serde(default)]
+    pub gamma_n: f64,
+    #[serde(default)]
+    pub gamma_t: f64,
+    #[serde(default)]
+    pub mu: f64,
+    /// Bond number Bo = F_c / (m g): the cohesive force in units of the weight of the
+    /// pair's mass scale (the particle's mass for equal particles; 0: no cohesion).
+    #[serde(default)]
+    pub bond: f64,
+    /// Cohesion range d_c, a gap in length units (paper 004: 10⁻⁴ widths).
+    #[serde(default)]
+    pub d_c: f64,
+}
+
+/// A rod (paper 004 sec. 2): a stadium of width the particle's `diameter` and length
+/// `aspect` times that (a segment swept by half the width; src/spheropolygon.rs).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RodSpec {
+    pub aspect: f64,
 }
 
 /// Power-law spring-dashpot, paper 000 eq. 2–5.
@@ -439,6 +476,10 @@ pub struct ParticleList {
     /// Convex polygons instead of disks.
     #[serde(default)]
     pub polygon: Option<PolygonSpec>,
+    /// Rods (spheropolygons) instead of disks: `diameter` is their width (law
+    /// `hertz_cohesive` only).
+    #[serde(default)]
+    pub rod: Option<RodSpec>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -155,6 +155,10 @@ fn reach_bounds(c: &Creation) -> (f64, f64) {
         (Creation::LatticePile(_) | Creation::Row(_), Some(p)) => {
             (lo, hi / (std::f64::consts::PI / p.corners as f64).cos())
         }
+        // A rod's circle is its length, `aspect` widths.
+        (Creation::List(l), None) if l.rod.is_some() => {
+            (lo, hi * l.rod.as_ref().map_or(1.0, |r| r.aspect.max(1.0)))
+        }
         _ => (lo, hi),
     }
 }
@@ -218,7 +222,7 @@ fn gpu_resolution_warning(scene: &Scene, law: &ContactLaw) -> Option<String> {
             l.delta0 * (weight / (l.k_n * l.delta0)).powf(1.0 / l.nu),
             GPU_RESOLUTION_DISKS,
         ),
-        ContactLaw::Continuous(_) => return None,
+        ContactLaw::Continuous(_) | ContactLaw::HertzCohesive(_) => return None,
     };
     let unit = law.range_factor() * max_diameter(scene) / (1u64 << 30) as f64;
     let limit = 1e3 * resolution * unit;
@@ -501,6 +505,7 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
 
     let g = scene.gravity.g;
     let law = ContactLaw::from_spec(&scene.contact, (g[0] * g[0] + g[1] * g[1]).sqrt())?;
+    spheropolygons(scene, &law)?;
     if let Some(tc) = shortest_contact_time(scene, &law) {
         if scene.dt > tc / MIN_STEPS_PER_CONTACT {
             return Err(SceneError::invalid(
@@ -551,4 +556,73 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
         }
     }
     Ok(warnings)
+}
+
+/// Rods (spheropolygons) and law `hertz_cohesive` go together (issue 15): rods need the
+/// law, the law takes rods and disks (disks as point cores) but not polygons, its
+/// cohesion range must lie within the neighbour search's margin, and such runs write no
+/// checkpoints yet.
+fn spheropolygons(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
+    let hertz = matches!(law, ContactLaw::HertzCohesive(_));
+    for (k, c) in scene.particles.iter().enumerate() {
+        let rod = match c {
+            Creation::List(l) => l.rod.as_ref(),
+            _ => None,
+        };
+        if let Some(r) = rod {
+            if !hertz {
+                return Err(SceneError::invalid(
+                    format!("particles[{k}].rod"),
+                    "rods need \"law\": \"hertz_cohesive\" (paper 004) in the contact block",
+                ));
+            }
+            if !(r.aspect.is_finite() && r.aspect >= 1.0) {
+                return Err(SceneError::invalid(
+                    format!("particles[{k}].rod.aspect"),
+                    format!("must be a number ≥ 1 (length over width), got {}", r.aspect),
+                ));
+            }
+            if polygon_of(c).is_some() {
+                return Err(SceneError::invalid(
+                    format!("particles[{k}].rod"),
+                    "a block makes rods or polygons, not both",
+                ));
+            }
+        }
+        if hertz && polygon_of(c).is_some() {
+            return Err(SceneError::invalid(
+                format!("particles[{k}].polygon"),
+                "law hertz_cohesive takes rods and disks; polygons need law overlap_area",
+            ));
+        }
+        if hertz && !matches!(c, Creation::List(_)) {
+            return Err(SceneError::invalid(
+                format!("particles[{k}]"),
+                "law hertz_cohesive takes particles given as a list so far (issue 15: point sources and box deposition of rods are not built yet)",
+            ));
+        }
+    }
+    if let ContactLaw::HertzCohesive(l) = law {
+        let smallest = (scene.particles.iter())
+            .map(|c| size_bounds(c).0)
+            .fold(f64::INFINITY, f64::min);
+        let limit = crate::law::hertz_cohesive::RANGE_MARGIN * smallest;
+        if l.d_c > limit {
+            return Err(SceneError::invalid(
+                "contact.d_c",
+                format!(
+                    "{} is beyond the neighbour search's margin: at most {:.1e} of the smallest particle's diameter, {limit:.3e} here",
+                    l.d_c,
+                    crate::law::hertz_cohesive::RANGE_MARGIN
+                ),
+            ));
+        }
+        if scene.output.checkpoint_every != Some(0.0) {
+            return Err(SceneError::invalid(
+                "output.checkpoint_every",
+                "must be 0 with law hertz_cohesive: checkpoints of spheropolygon runs (their sub-contact springs) are not built yet (issue 15)",
+            ));
+        }
+    }
+    Ok(())
 }

@@ -146,6 +146,7 @@ fn new_particle(position: P2, theta: f64, corners: Vec<P2>, radius: f64) -> NewP
         fixed_rotation: false,
         material: 0,
         corners,
+        sweep: 0.0,
     }
 }
 
