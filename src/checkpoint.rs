@@ -161,6 +161,8 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
                 axes: [v[1], v[2]],
                 start: v[3],
                 theta: v[4],
+                // Only rods have one, and rod runs write no checkpoints yet.
+                kick: [0.0; 2],
             })
         } else {
             None

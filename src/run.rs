@@ -219,6 +219,8 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
     );
     let mut checkpoints: Vec<PathBuf> = Vec::new();
     let mut settled = false;
+    // The mean kinetic energy per particle when the relaxation began (`kinetic_drop`).
+    let mut relaxing_from: Option<f64> = None;
     let mut vtk_entries = Vec::new();
     if engine.step() == 0 && snap_every.is_some() {
         let json = snapshot::write(engine.sim(), &snap_dir, &format!("snap_{:010}", 0))
@@ -298,6 +300,26 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
         }
         if step.is_multiple_of(check_every) {
             progress.update(step, time(step), engine.active_count() as usize);
+            if let Some(drop) = scene.stop.kinetic_drop
+                && time(step) >= scene.stop.not_before
+                && engine.sim().feeding_done()
+            {
+                // Paper 004's rule: the mean kinetic energy against its value when the
+                // relaxation began (the first check after the sources are done).
+                let sim = engine.sim();
+                let n = sim.particles.active_count().max(1) as f64;
+                let mean = sim.energies().kinetic() / n;
+                let start = *relaxing_from.get_or_insert(mean);
+                if mean < drop * start {
+                    progress.note(&format!(
+                        "relaxed at t = {:.4}: mean kinetic energy {mean:.3e}, {:.1e} of its {start:.3e} when the sources were done",
+                        sim.time(),
+                        mean / start
+                    ));
+                    settled = true;
+                    break;
+                }
+            }
             if let Some(frac) = scene.stop.kinetic_fraction
                 && time(step) >= scene.stop.not_before
             {

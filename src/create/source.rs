@@ -48,6 +48,9 @@ pub struct Drawn {
     pub axes: [f64; 2],
     pub start: f64,
     pub theta: f64,
+    /// A rod's random velocity added to the source's (`velocity_spread`; zero for the
+    /// other shapes, so checkpoints, which rod runs do not write yet, need not hold it).
+    pub kick: [f64; 2],
 }
 
 /// The candidates a source will place next, in order: the pending one, then fresh
@@ -109,9 +112,18 @@ fn size(s: &Size, rng: &mut Rng) -> f64 {
 /// Draws the next particle of a source, always in the same order: x, the size (one
 /// diameter, or the two axes), then for polygons φ0 (if irregular) and θ, uniform in
 /// [0, 2π/C) and [0, 2π).
+/// Rods: then θ uniform in [0, 2π), and the random velocity's speed (uniform in
+/// [0, velocity_spread)) and direction.
 fn draw(spec: &PointSource, rng: &mut Rng) -> Drawn {
     let x = spec.position[0] + rng.range(-spec.spread, spec.spread);
-    draw_shape(x, spec.diameter.as_ref(), spec.polygon.as_ref(), rng)
+    let mut d = draw_shape(x, spec.diameter.as_ref(), spec.polygon.as_ref(), rng);
+    if spec.rod.is_some() {
+        d.theta = rng.range(0.0, std::f64::consts::TAU);
+        let speed = rng.range(0.0, spec.velocity_spread);
+        let (s, c) = rng.range(0.0, std::f64::consts::TAU).sin_cos();
+        d.kick = [speed * c, speed * s];
+    }
+    d
 }
 
 /// The size and shape part of [`draw`] (also used by layered construction).
@@ -149,18 +161,28 @@ pub fn draw_shape(
         axes,
         start,
         theta,
+        kick: [0.0; 2],
     }
 }
 
 /// The particle a drawn candidate becomes (at the outlet, not yet placed).
 pub fn particle(spec: &PointSource, c: &Drawn, material: u32) -> NewParticle {
-    particle_at(
+    let velocity = [spec.velocity[0] + c.kick[0], spec.velocity[1] + c.kick[1]];
+    let mut p = particle_at(
         spec.polygon.as_ref(),
         c,
         [c.x, spec.position[1]],
-        spec.velocity,
+        velocity,
         material,
-    )
+    );
+    if let Some(rod) = &spec.rod {
+        // Paper 004's rod: width the drawn diameter, length `aspect` widths.
+        let s = crate::spheropolygon::Spheropolygon::rod(rod.aspect, c.axes[0]);
+        p.radius = s.circumradius();
+        p.sweep = s.radius;
+        p.corners = s.core;
+    }
+    p
 }
 
 /// The particle a drawn candidate becomes at `position`.

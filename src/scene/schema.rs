@@ -71,6 +71,13 @@ pub struct Stop {
     /// sec. 3: "kinetic energy orders of magnitude smaller than the elastic energy").
     #[serde(default)]
     pub kinetic_fraction: Option<f64>,
+    /// Stop early when the mean kinetic energy per particle falls below this fraction of
+    /// its value at the first check after the sources are done (paper 004 sec. 2:
+    /// "relaxed until the particles' mean kinetic energy is several orders of magnitude
+    /// smaller than its initial value"; unlike `kinetic_fraction` it works for cohesive
+    /// packings, whose elastic energy may be tiny or negative).
+    #[serde(default)]
+    pub kinetic_drop: Option<f64>,
     /// Simulated time between checks of the settling rule.
     #[serde(default = "default_check_every")]
     pub check_every: f64,
@@ -465,6 +472,14 @@ pub struct PointSource {
     /// Convex polygons instead of disks.
     #[serde(default)]
     pub polygon: Option<PolygonSpec>,
+    /// Rods instead of disks, of width `diameter`, each at a random orientation (paper
+    /// 004's deposition; law `hertz_cohesive` only).
+    #[serde(default)]
+    pub rod: Option<RodSpec>,
+    /// Rods only: a random speed up to this added to `velocity` in a random direction
+    /// (paper 004: "a random initial velocity and orientation").
+    #[serde(default)]
+    pub velocity_spread: f64,
 }
 
 /// Particles given one by one (small test scenes).

@@ -159,6 +159,9 @@ fn reach_bounds(c: &Creation) -> (f64, f64) {
         (Creation::List(l), None) if l.rod.is_some() => {
             (lo, hi * l.rod.as_ref().map_or(1.0, |r| r.aspect.max(1.0)))
         }
+        (Creation::PointSource(s), None) if s.rod.is_some() => {
+            (lo, hi * s.rod.as_ref().map_or(1.0, |r| r.aspect.max(1.0)))
+        }
         _ => (lo, hi),
     }
 }
@@ -342,6 +345,9 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
     finite_positive("stop.time", scene.stop.time)?;
     finite_positive("stop.check_every", scene.stop.check_every)?;
     finite_non_negative("stop.not_before", scene.stop.not_before)?;
+    if let Some(f) = scene.stop.kinetic_drop {
+        finite_positive("stop.kinetic_drop", f)?;
+    }
     if let Some(f) = scene.stop.kinetic_fraction {
         finite_positive("stop.kinetic_fraction", f)?;
     }
@@ -567,8 +573,21 @@ fn spheropolygons(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
     for (k, c) in scene.particles.iter().enumerate() {
         let rod = match c {
             Creation::List(l) => l.rod.as_ref(),
+            Creation::PointSource(p) => p.rod.as_ref(),
             _ => None,
         };
+        if let Creation::PointSource(p) = c {
+            finite_non_negative(
+                &format!("particles[{k}].velocity_spread"),
+                p.velocity_spread,
+            )?;
+            if p.velocity_spread > 0.0 && p.rod.is_none() {
+                return Err(SceneError::invalid(
+                    format!("particles[{k}].velocity_spread"),
+                    "applies to rods only (sources of disks and polygons pour at `velocity`)",
+                ));
+            }
+        }
         if let Some(r) = rod {
             if !hertz {
                 return Err(SceneError::invalid(
@@ -595,10 +614,10 @@ fn spheropolygons(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
                 "law hertz_cohesive takes rods and disks; polygons need law overlap_area",
             ));
         }
-        if hertz && !matches!(c, Creation::List(_)) {
+        if hertz && !matches!(c, Creation::List(_) | Creation::PointSource(_)) {
             return Err(SceneError::invalid(
                 format!("particles[{k}]"),
-                "law hertz_cohesive takes particles given as a list so far (issue 15: point sources and box deposition of rods are not built yet)",
+                "law hertz_cohesive takes particles from lists and point sources so far (issue 15)",
             ));
         }
     }
