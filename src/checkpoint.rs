@@ -92,8 +92,27 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
         }
         None => e.u8(0),
     }
+    // Spheropolygons (rods), only when the state has some, so that other checkpoints
+    // stay as they were: a tag, each particle's sweep, and each pair's sub-contact
+    // springs (pair key, count, then the count's keys and values).
+    if p.sweep.iter().any(|&s| s > 0.0) {
+        e.u8(SWEPT);
+        p.sweep.iter().for_each(|&v| e.f64(v));
+        e.u64(springs.sub.len() as u64);
+        for (&key, s) in &springs.sub {
+            e.u64(key);
+            e.u8(s.count as u8);
+            for k in 0..s.count {
+                e.u32(s.key[k]);
+                e.f64(s.xi[k]);
+            }
+        }
+    }
     e.bytes
 }
+
+/// The tag of the spheropolygon section at a checkpoint's end.
+const SWEPT: u8 = 1;
 
 pub fn write(sim: &Simulation, device: Option<&DeviceState>, path: &Path) -> std::io::Result<()> {
     write_atomic(path, &encode(sim, device))
@@ -212,12 +231,13 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
         }
         p.shape.push(corners);
     }
-    // Spheropolygon scenes write no checkpoints yet (scene validation): no sweeps here.
+    // Disks and polygons; a spheropolygon section at the end sets the sweeps.
     p.sweep = vec![0.0; n];
     let cap = d.u64().map_err(corrupt)? as usize;
     let mut springs = SpringTable {
         keys: Vec::with_capacity(cap),
         values: Vec::with_capacity(cap),
+        sub: Default::default(),
     };
     for _ in 0..cap {
         springs.keys.push(d.u64().map_err(corrupt)?);
@@ -253,6 +273,34 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
     } else {
         None
     };
+    if !d.is_done() {
+        // The spheropolygon section (`encode`).
+        let damaged = || corrupt(crate::files::DecodeError(bytes.len()));
+        if d.u8().map_err(corrupt)? != SWEPT {
+            return Err(damaged());
+        }
+        p.sweep = (0..n)
+            .map(|_| d.f64())
+            .collect::<Result<_, _>>()
+            .map_err(corrupt)?;
+        let entries = d.u64().map_err(corrupt)?;
+        for _ in 0..entries {
+            let key = d.u64().map_err(corrupt)?;
+            let count = d.u8().map_err(corrupt)? as usize;
+            if count > crate::spheropolygon::MAX_SUB {
+                return Err(damaged());
+            }
+            let mut s = crate::spheropolygon::SubSprings {
+                count,
+                ..Default::default()
+            };
+            for k in 0..count {
+                s.key[k] = d.u32().map_err(corrupt)?;
+                s.xi[k] = d.f64().map_err(corrupt)?;
+            }
+            springs.sub.insert(key, s);
+        }
+    }
     if !d.is_done() || !cap.is_power_of_two() {
         return Err(corrupt(crate::files::DecodeError(bytes.len())));
     }

@@ -146,9 +146,19 @@ impl NeighbourList {
             self.sub_history = (origin.iter())
                 .map(|o| o.map_or_else(Default::default, |k| old[k]))
                 .collect();
+        } else if !self.is_built() && !table.sub.is_empty() {
+            // The first list of a state with sub-contact springs (a checkpoint's).
+            self.sub_history = (pairs.iter())
+                .map(|&p| {
+                    table
+                        .sub
+                        .get(&pair_key(id_pair(p, ids)))
+                        .copied()
+                        .unwrap_or_default()
+                })
+                .collect();
         } else {
-            // The first list, or no spheropolygons: springs start afresh (their scenes
-            // write no checkpoints to start from yet).
+            // No spheropolygon springs to carry: they start afresh.
             self.sub_history.clear();
         }
         let history = if self.is_built() {
@@ -179,6 +189,13 @@ impl NeighbourList {
         for ((p, h), &c) in self.pairs.iter().zip(&self.history).zip(in_contact) {
             if c {
                 t.insert(pair_key(id_pair(*p, ids)), *h);
+            }
+        }
+        if self.sub_history.len() == self.pairs.len() {
+            for (p, s) in self.pairs.iter().zip(&self.sub_history) {
+                if s.count > 0 {
+                    t.sub.insert(pair_key(id_pair(*p, ids)), *s);
+                }
             }
         }
         t

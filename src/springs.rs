@@ -32,6 +32,9 @@ pub fn hash(key: u64) -> u64 {
 pub struct SpringTable {
     pub keys: Vec<u64>,
     pub values: Vec<f64>,
+    /// Spheropolygon pairs (law hertz_cohesive): each pair's sub-contact springs, keyed
+    /// by the pair (the sub-contacts inside by their own keys, `SubSprings`).
+    pub sub: std::collections::BTreeMap<u64, crate::spheropolygon::SubSprings>,
 }
 
 impl Default for SpringTable {
@@ -47,6 +50,7 @@ impl SpringTable {
         Self {
             keys: vec![EMPTY; cap],
             values: vec![0.0; cap],
+            sub: Default::default(),
         }
     }
 

@@ -207,16 +207,37 @@ fn a_rod_pile_is_bitwise_the_same_on_any_thread_count_and_skin() {
 }
 
 #[test]
-fn rods_need_their_law_and_their_law_no_polygons_nor_checkpoints() {
+fn a_rod_pile_resumes_bitwise_from_a_checkpoint() {
+    // The sweeps and every pair's sub-contact springs travel in the checkpoint: a run
+    // resumed halfway ends bitwise where the straight run does.
+    let v = pile(None);
+    let straight = run_on(1, &v, 12_000);
+    let half = run_on(1, &v, 6_000);
+    let springs = half.spring_table();
+    assert!(
+        !springs.sub.is_empty(),
+        "the checkpoint carries sub-contact springs"
+    );
+    let path = std::env::temp_dir().join(format!("talus-rods-{}.ckpt", std::process::id()));
+    talus::checkpoint::write(&half, None, &path).unwrap();
+    let mut resumed = talus::checkpoint::read(&path, &[]).unwrap().sim;
+    let _ = std::fs::remove_file(&path);
+    assert_eq!(resumed.particles.sweep, half.particles.sweep);
+    resumed.advance(6_000).unwrap();
+    same_state(&straight, &resumed, "resumed");
+}
+
+#[test]
+fn rods_need_their_law_and_their_law_no_polygons() {
     let rod = json!([{ "position": [0.0, 0.5], "diameter": 1.0 }]);
     let mut v = rods(json!({}), rod.clone(), true);
     v["contact"] = json!({ "law": "spring_dashpot", "k_n": 1e4 });
     let e = talus::scene::parse(&v.to_string(), &[]).expect_err("rods need hertz_cohesive");
     assert!(e.to_string().contains("particles[0].rod"), "{e}");
     let mut v = rods(json!({}), rod.clone(), true);
-    v["output"] = json!({});
-    let e = talus::scene::parse(&v.to_string(), &[]).expect_err("no checkpoints yet");
-    assert!(e.to_string().contains("output.checkpoint_every"), "{e}");
+    v["particles"][0]["polygon"] = json!({ "corners": 6 });
+    let e = talus::scene::parse(&v.to_string(), &[]).expect_err("rods or polygons");
+    assert!(e.to_string().contains("particles[0]"), "{e}");
     let v = rods(json!({ "d_c": 0.01 }), rod, true);
     let e = talus::scene::parse(&v.to_string(), &[]).expect_err("d_c beyond the margin");
     assert!(e.to_string().contains("contact.d_c"), "{e}");

@@ -565,9 +565,8 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
 }
 
 /// Rods (spheropolygons) and law `hertz_cohesive` go together (issue 15): rods need the
-/// law, the law takes rods and disks (disks as point cores) but not polygons, its
-/// cohesion range must lie within the neighbour search's margin, and such runs write no
-/// checkpoints yet.
+/// law, the law takes rods and disks (disks as point cores) but not polygons, and its
+/// cohesion range must lie within the neighbour search's margin.
 fn spheropolygons(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
     let hertz = matches!(law, ContactLaw::HertzCohesive(_));
     for (k, c) in scene.particles.iter().enumerate() {
@@ -634,12 +633,6 @@ fn spheropolygons(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
                     l.d_c,
                     crate::law::hertz_cohesive::RANGE_MARGIN
                 ),
-            ));
-        }
-        if scene.output.checkpoint_every != Some(0.0) {
-            return Err(SceneError::invalid(
-                "output.checkpoint_every",
-                "must be 0 with law hertz_cohesive: checkpoints of spheropolygon runs (their sub-contact springs) are not built yet (issue 15)",
             ));
         }
     }
