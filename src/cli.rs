@@ -117,10 +117,10 @@ enum Command {
         #[arg(long)]
         g: Option<f64>,
     },
-    /// Run one of the papers' scenes (R1–R8; reduced unless --full), then
+    /// Run one of the papers' scenes (R1–R9; reduced unless --full), then
     /// measure and draw it; writes reproduce.json with the numbers it is judged by.
     Reproduce {
-        /// R1 to R8.
+        /// R1 to R9.
         id: String,
         /// The paper's size instead of the reduced form.
         #[arg(long)]
@@ -590,6 +590,14 @@ fn cmd_reproduce(
             a.coordination_interior
         );
     }
+    let trends = if id == "R9" {
+        reproduce::r9_trends(&found)
+    } else {
+        Vec::new()
+    };
+    for t in &trends {
+        out!("{id}: {t}");
+    }
     let comparisons = reproduce::comparisons(&id, &found);
     for c in &comparisons {
         out!(
@@ -606,6 +614,7 @@ fn cmd_reproduce(
         "claim": reproduce::claim(&id),
         "seed_averages": averages,
         "comparisons": comparisons,
+        "trends": trends,
         "variants": found,
         "failed": failed,
     });

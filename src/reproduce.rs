@@ -1,4 +1,4 @@
-//! `talus reproduce ID`: the scenes of SPEC 6 (R1–R8) with the measurements that decide
+//! `talus reproduce ID`: the scenes of SPEC 6 (R1–R9) with the measurements that decide
 //! whether each reproduces its paper's result. The scene files are built in, so the
 //! command runs anywhere; reduced forms by default, the paper's sizes with `--full`.
 
@@ -32,6 +32,7 @@ const R8: &str = include_str!("../scenes/r8_polygon_pile.json");
 /// Grains per second of the R7 wedge sources (one every 0.075 s, as in R6).
 const R7_RATE: f64 = 40.0 / 3.0;
 const R8_REDUCED: &str = include_str!("../scenes/r8_polygon_pile_reduced.json");
+const R9_REDUCED: &str = include_str!("../scenes/r9_rods_reduced.json");
 
 /// What R1–R9 reproduce (SPEC 6), in one line each.
 pub fn claim(id: &str) -> &'static str {
@@ -54,6 +55,9 @@ pub fn claim(id: &str) -> &'static str {
             "slopes near 23°, 24°, 28° (wedge) and 32° (layered); dip for polydisperse wedge heaps only"
         }
         "R8" => "stress independent of μ within fluctuations; no clear dip",
+        "R9" => {
+            "the packing fraction of deposited rods falls with the aspect ratio d and with the Bond number"
+        }
         _ => "",
     }
 }
@@ -68,7 +72,7 @@ fn v(name: &str, scene: &'static str, overrides: &[&str], window: f64, row: f64)
     }
 }
 
-/// The runs of reproduction `id` (R1–R8).
+/// The runs of reproduction `id` (R1–R9; R9 reduced only).
 pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
     let r7 = |name: &str, scene: &'static str| v(name, scene, &[], 14.0, 2.0);
     let lattice = |name: &str, set: Vec<String>| {
@@ -240,13 +244,89 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
                 x
             })
             .collect(),
+        // R9 reduced (paper 004): 300 rods per run instead of 6000, fed into a box 20 d
+        // wide, Bond numbers 0, 10² and 10³ (the paper's 10⁴ would press the contacts of
+        // k^N = 10⁷ by a fifth of a width: it needs a stiffer law and a smaller step).
+        "R9" if !full => {
+            let rods = |d: f64, bond: f64| {
+                let half = 10.0 * d;
+                let mut x = v(&format!("d{d}-bo{bond}"), R9_REDUCED, &[], 4.0 * d, 2.0 * d);
+                x.overrides = vec![
+                    format!("particles[0].rod.aspect={d}"),
+                    format!("particles[0].spread={}", half - 0.5 * d - 1.0),
+                    format!("contact.bond={bond}"),
+                    format!("domain.x=[{},{}]", -half - 5.0, half + 5.0),
+                    format!("walls[0].from=[{},0]", -half),
+                    format!("walls[0].to=[{half},0]"),
+                    format!("walls[1].from=[{},0]", -half),
+                    format!("walls[1].to=[{},70]", -half),
+                    format!("walls[2].from=[{half},0]"),
+                    format!("walls[2].to=[{half},70]"),
+                ];
+                x
+            };
+            vec![
+                rods(2.0, 0.0),
+                rods(5.0, 0.0),
+                rods(10.0, 0.0),
+                rods(5.0, 100.0),
+                rods(5.0, 1000.0),
+            ]
+        }
         "R9" => {
             return Err(format!(
-                "{id}: rods are not built yet (see the README's status)"
+                "{id}: only the reduced R9 is built (300 rods per run; drop --full)"
             ));
         }
         _ => return Err(format!("unknown reproduction `{id}`: R1 to R9")),
     })
+}
+
+/// R9's trends: the packing fraction against d at Bo = 0 and against Bo at d = 5 (runs
+/// named `dD-boB`), each with whether it falls as paper 004 finds.
+pub fn r9_trends(found: &[Findings]) -> Vec<String> {
+    let phi = |name: &str| {
+        (found.iter())
+            .find(|f| f.variant == name)
+            .map(|f| f.packing_fraction_lower_half)
+    };
+    let trend = |what: &str, names: &[(&str, &str)]| -> Option<String> {
+        let values: Vec<f64> = names.iter().map(|(n, _)| phi(n)).collect::<Option<_>>()?;
+        let falls = values.windows(2).all(|w| w[1] < w[0]);
+        let listed: Vec<String> = (names.iter().zip(&values))
+            .map(|((_, label), p)| format!("{label}: {p:.3}"))
+            .collect();
+        Some(format!(
+            "packing fraction against {what}: {} ({})",
+            listed.join(", "),
+            if falls {
+                "falls, as in paper 004"
+            } else {
+                "does not fall throughout"
+            }
+        ))
+    };
+    [
+        trend(
+            "d at Bo = 0",
+            &[
+                ("d2-bo0", "d = 2"),
+                ("d5-bo0", "d = 5"),
+                ("d10-bo0", "d = 10"),
+            ],
+        ),
+        trend(
+            "Bo at d = 5",
+            &[
+                ("d5-bo0", "Bo = 0"),
+                ("d5-bo100", "Bo = 100"),
+                ("d5-bo1000", "Bo = 1000"),
+            ],
+        ),
+    ]
+    .into_iter()
+    .flatten()
+    .collect()
 }
 
 /// The numbers a reproduction is judged by, from one variant's analysis.
@@ -502,6 +582,28 @@ mod tests {
             base_load_left_max_mg: None,
             base_load_right_max_mg: None,
         }
+    }
+
+    #[test]
+    fn r9_trends_say_whether_the_packing_fraction_falls() {
+        let phi = |name: &str, p: f64| Findings {
+            packing_fraction_lower_half: p,
+            ..run(name, Vec::new())
+        };
+        let found = [
+            phi("d2-bo0", 0.85),
+            phi("d5-bo0", 0.82),
+            phi("d10-bo0", 0.74),
+            phi("d5-bo100", 0.78),
+            phi("d5-bo1000", 0.80),
+        ];
+        let t = r9_trends(&found);
+        assert_eq!(t.len(), 2);
+        assert!(t[0].contains("d = 10: 0.740") && t[0].contains("falls, as in paper 004"));
+        assert!(t[1].contains("does not fall throughout"), "{}", t[1]);
+        // A run that is missing leaves its trend out.
+        assert_eq!(r9_trends(&found[..3]).len(), 1);
+        assert!(variants("R9", false).unwrap().len() == 5 && variants("R9", true).is_err());
     }
 
     #[test]
