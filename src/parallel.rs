@@ -97,15 +97,32 @@ where
 {
     assert_eq!(a.len(), b.len());
     let parts = threads_for(a.len());
-    let bd = bounds(a.len(), parts, block);
+    // Candidates differ in cost (a touching polygon pair is clipped, a distant one is
+    // not), so each thread's share is cut into pieces: a thread takes its own in order,
+    // then helps with what is left of the others'. Who computes a piece changes no
+    // result.
+    let pieces = if parts > 1 { PIECES } else { 1 };
+    let bd = bounds(a.len(), parts * pieces, block);
     let (sa, sb) = (shares(a, &bd), shares(b, &bd));
+    let next: Vec<AtomicUsize> = (0..parts).map(|t| AtomicUsize::new(t * pieces)).collect();
     crate::team::run(parts, &|t| {
-        let (mut x, mut y) = (take(&sa, t), take(&sb, t));
-        for (m, (x, y)) in x.chunks_mut(block).zip(y.chunks_mut(block)).enumerate() {
-            f(bd[t] + m * block, x, y);
+        for owner in (0..parts).map(|o| (t + o) % parts) {
+            loop {
+                let k = next[owner].fetch_add(1, Ordering::Relaxed);
+                if k >= (owner + 1) * pieces {
+                    break;
+                }
+                let (mut x, mut y) = (take(&sa, k), take(&sb, k));
+                for (m, (x, y)) in x.chunks_mut(block).zip(y.chunks_mut(block)).enumerate() {
+                    f(bd[k] + m * block, x, y);
+                }
+            }
         }
     });
 }
+
+/// Pieces per thread of a stage over candidates (`for_each_block2`).
+const PIECES: usize = 8;
 
 /// f(k, [&mut v0[k], …, &mut v5[k]]) for every k: the six Gear values of a particle.
 pub fn for_each6<T, F>(v: &mut [Vec<T>; 6], f: F)
