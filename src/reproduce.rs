@@ -306,7 +306,7 @@ pub fn r9_trends(found: &[Findings]) -> Vec<String> {
             }
         ))
     };
-    [
+    let mut out: Vec<String> = [
         trend(
             "d at Bo = 0",
             &[
@@ -326,7 +326,18 @@ pub fn r9_trends(found: &[Findings]) -> Vec<String> {
     ]
     .into_iter()
     .flatten()
-    .collect()
+    .collect();
+    // f(θ): without cohesion long rods lie flat; cohesion makes f(θ) flatter (paper 004
+    // Fig. 3): fewer lying, more standing.
+    for f in found.iter().filter(|f| f.variant.starts_with('d')) {
+        out.push(format!(
+            "{}: {:.0} % of the rods lie within 20° of the horizontal, {:.0} % stand within 20° of the vertical (uniform: 22 % each)",
+            f.variant,
+            100.0 * f.lying_fraction,
+            100.0 * f.standing_fraction
+        ));
+    }
+    out
 }
 
 /// The numbers a reproduction is judged by, from one variant's analysis.
@@ -358,6 +369,10 @@ pub struct Findings {
     pub base_load_centre_mg: Option<f64>,
     pub base_load_left_max_mg: Option<f64>,
     pub base_load_right_max_mg: Option<f64>,
+    /// Of the grains with a long axis (polygons, rods), the fractions lying within 20° of
+    /// the horizontal and standing within 20° of the vertical (from f(θ)).
+    pub lying_fraction: f64,
+    pub standing_fraction: f64,
 }
 
 pub fn findings(variant: &str, a: &Analysis) -> Findings {
@@ -423,7 +438,24 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
         base_load_centre_mg: s.base_load.as_ref().map(|b| b.centre / b.grain_weight),
         base_load_left_max_mg: s.base_load.as_ref().map(|b| b.left_max / b.grain_weight),
         base_load_right_max_mg: s.base_load.as_ref().map(|b| b.right_max / b.grain_weight),
+        lying_fraction: orientation_fraction(&a.orientation, |t| {
+            t.min(PI - t) < 20f64.to_radians()
+        }),
+        standing_fraction: orientation_fraction(&a.orientation, |t| {
+            (t - 0.5 * PI).abs() < 20f64.to_radians()
+        }),
     }
+}
+
+use std::f64::consts::PI;
+
+/// The fraction of f(θ) (bins of equal width over [0, π)) whose bin centres satisfy `at`.
+fn orientation_fraction(f: &[(f64, f64)], at: impl Fn(f64) -> bool) -> f64 {
+    let width = PI / f.len().max(1) as f64;
+    f.iter()
+        .filter(|(t, _)| at(*t))
+        .map(|(_, p)| p * width)
+        .sum()
 }
 
 /// The row-1 S_zz profile averaged over the seeds of one setting (variants named
@@ -581,6 +613,8 @@ mod tests {
             base_load_centre_mg: None,
             base_load_left_max_mg: None,
             base_load_right_max_mg: None,
+            lying_fraction: 0.0,
+            standing_fraction: 0.0,
         }
     }
 
@@ -598,11 +632,17 @@ mod tests {
             phi("d5-bo1000", 0.80),
         ];
         let t = r9_trends(&found);
-        assert_eq!(t.len(), 2);
+        assert_eq!(t.len(), 2 + found.len());
         assert!(t[0].contains("d = 10: 0.740") && t[0].contains("falls, as in paper 004"));
         assert!(t[1].contains("does not fall throughout"), "{}", t[1]);
         // A run that is missing leaves its trend out.
-        assert_eq!(r9_trends(&found[..3]).len(), 1);
+        assert_eq!(r9_trends(&found[..3]).len(), 1 + 3);
+        // f(θ) uniform over 18 bins: 4 of them lie within 20° of the horizontal.
+        let uniform: Vec<(f64, f64)> = (0..18)
+            .map(|k| ((k as f64 + 0.5) * PI / 18.0, 1.0 / PI))
+            .collect();
+        let lying = orientation_fraction(&uniform, |t| t.min(PI - t) < 20f64.to_radians());
+        assert!((lying - 4.0 / 18.0).abs() < 1e-12, "{lying}");
         assert!(variants("R9", false).unwrap().len() == 5 && variants("R9", true).is_err());
     }
 
