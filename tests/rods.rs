@@ -300,3 +300,54 @@ fn rods_poured_into_a_box_settle_and_stop_by_their_mean_kinetic_energy() {
     assert!(summary["time"].as_f64().unwrap() < 30.0);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn a_rod_rests_on_an_edge_until_its_centre_passes_it_and_then_tips_over() {
+    // A floor ending at x = 0, a rod of aspect 3 (core from −1 to 1 about its centre)
+    // lying on it: the floor's end corner holds it up while the centre lies over the
+    // floor; once the centre is past the corner the rod turns about it and falls.
+    let drop = |x: f64| {
+        let mut v = rods(
+            json!({}),
+            json!([{ "position": [x, 0.5], "diameter": 1.0 }]),
+            false,
+        );
+        v["walls"] = json!([{ "from": [-20.0, 0.0], "to": [0.0, 0.0] }]);
+        settle(&v, 2.0).particles.q[0][0]
+    };
+    let held = drop(-0.3);
+    // Held on the left end and the corner (the corner, nearer the centre, carries more
+    // and sinks deeper: a tilt of ~(δ_corner − δ_end)/1.3 ≈ 0.01).
+    assert!(
+        held[2].abs() < 0.02 && (held[1] - 0.5).abs() < 0.05,
+        "held: {held:?}"
+    );
+    let tipped = drop(0.3);
+    assert!(tipped[2] < -0.5 && tipped[1] < -1.0, "tipped: {tipped:?}");
+}
+
+#[test]
+fn a_disk_among_rods_is_a_point_core_under_the_same_law() {
+    // A disk (a point swept by its radius) resting on a rod lying on the floor: each
+    // contact carries what Hertz says, the disk's weight on the rod.
+    let mut v = rods(
+        json!({}),
+        json!([{ "position": [0.0, 0.5], "diameter": 1.0 }]),
+        true,
+    );
+    v["particles"].as_array_mut().unwrap().push(
+        json!({ "kind": "list", "material": "m", "particles": [
+            { "position": [0.0, 1.5], "diameter": 1.0 }
+        ]}),
+    );
+    let s = settle(&v, 3.0);
+    // The disk of diameter 1 and density 4/π has unit mass.
+    let m = s.particles.mass[1];
+    assert!((m - 1.0).abs() < 1e-12);
+    let (rod, disk) = (s.particles.q[0][0][1], s.particles.q[0][1][1]);
+    let delta = (m * G / K_N).powf(2.0 / 3.0);
+    assert!(
+        (rod + 1.0 - disk - delta).abs() < 1e-6 * delta,
+        "rod {rod}, disk {disk}"
+    );
+}
