@@ -387,7 +387,8 @@ fn candidates_of(s: &Search, i: usize, out: &mut Vec<Pair>) {
 }
 
 /// For each new candidate, the index of the same pair in the old list (None: a new
-/// pair): the merge of `carry_over`, for arrays of any type.
+/// pair): both lists are in the same memory order and sorted by (slot of i, partner
+/// id), so one merge finds every pair that stays a candidate.
 fn origins(old: &[Pair], new: &[Pair], ids: &[u32]) -> Vec<Option<usize>> {
     let key = |p: &Pair| (p.i, partner_key(*p, ids));
     let mut out = Vec::with_capacity(new.len());
@@ -401,24 +402,11 @@ fn origins(old: &[Pair], new: &[Pair], ids: &[u32]) -> Vec<Option<usize>> {
     out
 }
 
-/// Each new candidate's history from the old list: both are in the same memory order
-/// and sorted by (slot of i, partner id), so one merge finds every pair that stays a
-/// candidate; a new pair starts at 0.
+/// Each new candidate's history from the old list (`origins`); a new pair starts at 0.
 fn carry_over(old: &[Pair], values: &[f64], new: &[Pair], ids: &[u32]) -> Vec<f64> {
-    let key = |p: &Pair| (p.i, partner_key(*p, ids));
-    let mut out = Vec::with_capacity(new.len());
-    let mut k = 0;
-    for p in new {
-        while k < old.len() && key(&old[k]) < key(p) {
-            k += 1;
-        }
-        out.push(if k < old.len() && old[k] == *p {
-            values[k]
-        } else {
-            0.0
-        });
-    }
-    out
+    (origins(old, new, ids).into_iter())
+        .map(|o| o.map_or(0.0, |k| values[k]))
+        .collect()
 }
 
 /// For each slot the candidates in which it is the higher id (j), by increasing partner
