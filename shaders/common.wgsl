@@ -16,6 +16,7 @@ const EMPTY: u32 = 0xFFFFFFFFu;
 const LAW_SPRING_DASHPOT: u32 = 0u;
 const LAW_CONTINUOUS: u32 = 1u;
 const LAW_AREA: u32 = 2u;
+const LAW_HERTZ: u32 = 3u;
 // Props.flags
 const ACTIVE: u32 = 1u;
 const FIXED: u32 = 2u;
@@ -107,6 +108,10 @@ struct Params {
     // 1: sort the particles in memory by cell at every rebuild (permute.wgsl); 0: keep
     // them where they are (tests: the results must not depend on it)
     reorder: u32,
+    // hertz_cohesive (paper 004 sec. 2): Bo g, the cohesive pull per unit of the
+    // contact's mass scale, and the cohesion range d_c (length)
+    bond_g: f32,
+    d_c: f32,
 };
 
 // Dynamic state: q[0] = (rem_x, rem_z, rem_theta, 0) with the position's remainder in
@@ -155,6 +160,15 @@ struct Entry {
     j: u32,
     value: f32,
     _pad: u32,
+};
+
+// A spheropolygon pair's tangential springs, one per sub-contact (src/spheropolygon.rs
+// `SubSprings`; MAX_SUB = 4): the sub-contact's key (`SubContact::key`, EMPTY for none)
+// and its spring. Per candidate slot (`sub_hist`) and per entry of the spring table
+// (`table_sub`, beside `table`).
+struct SubSprings {
+    key: vec4<u32>,
+    xi: vec4<f32>,
 };
 
 struct Source {

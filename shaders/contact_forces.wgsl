@@ -43,7 +43,7 @@ fn velocity(i: u32) -> vec3<f32> {
 }
 
 // Disks: a thread per particle, over its own list (its state read once for all its
-// candidates). The overlap-area law: a thread per pair of the compact list find_contacts
+// candidates). The overlap-area law and spheropolygons: a thread per pair of the compact list find_contacts
 // wrote (`pairs`), dispatched with the workgroups `plan_pairs` wrote (striding over any
 // beyond them): a polygon pair costs far more than a disk pair, and a thread per
 // particle would run a third as many threads, each keeping the others of its group
@@ -52,12 +52,16 @@ fn velocity(i: u32) -> vec3<f32> {
 fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>,
                   @builtin(num_workgroups) groups: vec3<u32>) {
     if (halted()) { return; }
-    if (POLYGONS) {
+    if (POLYGONS || SPHEROPOLYGONS) {
         let total = atomicLoad(&pairs.count);
         for (var t = gid.x; t < total; t += groups.x * WG) {
             let slot = pairs.slot[t];
             let i = slot / MAX_CONTACTS;
-            candidate_force(i, slot, props[i].radius, props[i].mass, velocity(i));
+            if (SPHEROPOLYGONS) {
+                spheropolygon_force(i, slot, props[i].mass, velocity(i));
+            } else {
+                candidate_force(i, slot, props[i].radius, props[i].mass, velocity(i));
+            }
         }
         return;
     }

@@ -96,9 +96,10 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     contact_count[i] = n;
-    // Under the overlap-area law contact_forces takes a thread per pair: the list of
-    // them (in no particular order; each pair's result goes to its own slot).
-    if (POLYGONS && n > 0u) {
+    // Under the overlap-area law and for spheropolygons contact_forces takes a thread
+    // per pair: the list of them (in no particular order; each pair's result goes to its
+    // own slot).
+    if ((POLYGONS || SPHEROPOLYGONS) && n > 0u) {
         let base = atomicAdd(&pairs.count, n);
         for (var k = 0u; k < n; k++) { pairs.slot[base + k] = i * MAX_CONTACTS + k; }
     }

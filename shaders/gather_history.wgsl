@@ -8,15 +8,16 @@
 // two threads never race for the same key; slot positions may vary between runs but a
 // lookup always finds the one entry of its key, so results are deterministic.
 
-fn lookup(i: u32, j: u32) -> f32 {
+// The table slot of key (i, j), EMPTY when it is not there.
+fn find_entry(i: u32, j: u32) -> u32 {
     var slot = hash_pair(i, j) & params.table_mask;
     for (var probe = 0u; probe <= params.table_mask; probe++) {
         let k = atomicLoad(&table[slot].i);
-        if (k == EMPTY) { return 0.0; }
-        if (k == i && table[slot].j == j) { return table[slot].value; }
+        if (k == EMPTY) { return EMPTY; }
+        if (k == i && table[slot].j == j) { return slot; }
         slot = (slot + 1u) & params.table_mask;
     }
-    return 0.0;
+    return EMPTY;
 }
 
 // Particle p's down list (its candidates as the higher id) sorted by the id of the lower
@@ -42,9 +43,19 @@ fn sort_down_list(p: u32) {
 fn gather_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= live() || halted() || !rebuilding()) { return; }
+    let swept = params.law == LAW_HERTZ;
     for (var k = 0u; k < contact_count[i]; k++) {
         let slot = i * MAX_CONTACTS + k;
-        hist_in[slot] = lookup(ids[i], partner_key(contact_j[slot]));
+        let e = find_entry(ids[i], partner_key(contact_j[slot]));
+        var value = 0.0;
+        if (e != EMPTY) { value = table[e].value; }
+        hist_in[slot] = value;
+        // A spheropolygon pair's springs are its sub-contacts' (`table_sub`).
+        if (swept) {
+            var sub = SubSprings(vec4<u32>(EMPTY), vec4<f32>(0.0));
+            if (e != EMPTY) { sub = table_sub[e]; }
+            sub_hist[slot] = sub;
+        }
     }
     sort_down_list(i);
 }

@@ -45,8 +45,13 @@ fn elastic_energy(delta: f32) -> f32 {
 
 // Coulomb-capped spring, paper 000 eq. 4-5: returns (f_t, new xi).
 fn coulomb_spring(xi0: f32, v_t: f32, dt: f32, f_n: f32) -> vec2<f32> {
+    return damped_coulomb_spring(xi0, v_t, dt, f_n, params.gamma_t);
+}
+
+// The same with the damping coefficient given (src/law/tangential.rs `coulomb_spring`).
+fn damped_coulomb_spring(xi0: f32, v_t: f32, dt: f32, f_n: f32, gamma_t: f32) -> vec2<f32> {
     let xi = xi0 + v_t * dt;
-    let trial = -params.k_t * xi - params.gamma_t * v_t;
+    let trial = -params.k_t * xi - gamma_t * v_t;
     let cap = params.mu * f_n;
     if (abs(trial) <= cap) { return vec2<f32>(trial, xi); }
     let f_t = select(-cap, cap, trial >= 0.0);
@@ -158,8 +163,28 @@ fn overlap_area(c: ContactInput) -> ContactOutput {
     return ContactOutput(f_n, f_t, xs, energy);
 }
 
+// Paper 004's law (src/law/hertz_cohesive.rs): F_N = k^N delta^{3/2} + gamma^N m12
+// delta_dot, clamped at 0, a Coulomb-capped spring damped by gamma^T m12, and a constant
+// pull F_c = Bo g m while the gap is below d_c (delta > -d_c; `c.mass` is m).
+fn hertz_cohesive(c: ContactInput) -> ContactOutput {
+    if (!(c.delta > -params.d_c)) { return ContactOutput(0.0, 0.0, 0.0, 0.0); }
+    let f_c = params.bond_g * c.mass;
+    var f_rep = 0.0;
+    var elastic = 0.0;
+    var t = vec2<f32>(0.0);
+    if (c.delta > 0.0) {
+        let d32 = c.delta * sqrt(c.delta);
+        f_rep = max(params.k_n * d32 + params.gamma_n * c.m12 * c.delta_dot, 0.0);
+        elastic = 0.4 * params.k_n * d32 * c.delta;
+        t = damped_coulomb_spring(c.history, c.v_t, c.dt, f_rep, params.gamma_t * c.m12);
+    }
+    let energy = elastic + 0.5 * params.k_t * t.y * t.y - f_c * (c.delta + params.d_c);
+    return ContactOutput(f_rep - f_c, t.x, t.y, energy);
+}
+
 fn evaluate(c: ContactInput) -> ContactOutput {
     if (params.law == LAW_SPRING_DASHPOT) { return spring_dashpot(c); }
     if (params.law == LAW_AREA) { return overlap_area(c); }
+    if (params.law == LAW_HERTZ) { return hertz_cohesive(c); }
     return continuous(c);
 }

@@ -33,6 +33,9 @@ const MAX_CORNERS: u32 = 16u;
 override POLYGON_SHAPES: bool = true;
 override DISK_SHAPES: bool = true;
 override WALLS: bool = true;
+// Set when the pipelines are built for spheropolygons (law hertz_cohesive;
+// spheropolygon.wgsl); like POLYGONS, contact_forces then takes a thread per pair.
+override SPHEROPOLYGONS: bool = false;
 
 struct AreaContact {
     area: f32,

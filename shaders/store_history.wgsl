@@ -20,30 +20,35 @@ fn clear_table(@builtin(global_invocation_id) gid: vec3<u32>,
     }
 }
 
-// Key (id of i, partner key of j); `owner`: i's memory slot (for a halt).
-fn insert(i: u32, j: u32, value: f32, owner: u32) {
+// Key (id of i, partner key of j); `owner`: i's memory slot (for a halt). Returns the
+// entry's slot (EMPTY when the table is full).
+fn insert(i: u32, j: u32, value: f32, owner: u32) -> u32 {
     var slot = hash_pair(i, j) & params.table_mask;
     for (var probe = 0u; probe <= params.table_mask; probe++) {
         let r = atomicCompareExchangeWeak(&table[slot].i, EMPTY, i);
         if (r.exchanged) {
             table[slot].j = j;
             table[slot].value = value;
-            return;
+            return slot;
         }
         if (r.old_value == EMPTY) { continue; } // spurious failure: try the slot again
         slot = (slot + 1u) & params.table_mask;
     }
     halt(HALT_TABLE_FULL, owner);
+    return EMPTY;
 }
 
 @compute @workgroup_size(WG)
 fn store_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= live() || halted() || !storing()) { return; }
+    let swept = params.law == LAW_HERTZ;
     for (var k = 0u; k < contact_count[i]; k++) {
         let slot = i * MAX_CONTACTS + k;
         if (touching[slot] != 0u) {
-            insert(ids[i], partner_key(contact_j[slot]), hist_in[slot], i);
+            let e = insert(ids[i], partner_key(contact_j[slot]), hist_in[slot], i);
+            // A spheropolygon pair's sub-contact springs go beside the entry.
+            if (swept && e != EMPTY) { table_sub[e] = sub_hist[slot]; }
         }
     }
 }

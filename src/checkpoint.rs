@@ -107,6 +107,12 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
                 e.f64(s.xi[k]);
             }
         }
+        // From a GPU run: the device's sub-contact springs beside `springs` above.
+        if let Some(ds) = device {
+            let raw = bytemuck::cast_slice::<_, u8>(&ds.sub);
+            e.u64(raw.len() as u64);
+            e.bytes.extend_from_slice(raw);
+        }
     }
     e.bytes
 }
@@ -246,7 +252,7 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
         springs.values.push(d.f64().map_err(corrupt)?);
     }
     let flag = d.u8().map_err(corrupt)?;
-    let device_state = if flag != 0 {
+    let mut device_state = if flag != 0 {
         let mut raw = || -> Result<&[u8], crate::files::DecodeError> {
             let n = d.u64()? as usize;
             d.take(n)
@@ -268,6 +274,7 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
                 states: bytemuck::pod_collect_to_vec(states),
                 props: bytemuck::pod_collect_to_vec(props),
                 springs: bytemuck::pod_collect_to_vec(springs),
+                sub: Vec::new(),
             })
         }
     } else {
@@ -299,6 +306,15 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
                 s.xi[k] = d.f64().map_err(corrupt)?;
             }
             springs.sub.insert(key, s);
+        }
+        if let Some(ds) = device_state.as_mut() {
+            let n = d.u64().map_err(corrupt)? as usize;
+            let raw = d.take(n).map_err(corrupt)?;
+            let size = size_of::<crate::gpu::layout::SubSprings>();
+            if raw.len() % size != 0 || (!raw.is_empty() && raw.len() / size != ds.springs.len()) {
+                return Err(damaged());
+            }
+            ds.sub = bytemuck::pod_collect_to_vec(raw);
         }
     }
     if !d.is_done() || !cap.is_power_of_two() {

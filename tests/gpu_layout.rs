@@ -98,7 +98,7 @@ fn rust_layouts_match_wgsl() {
         }
         checked += 1;
     }
-    assert_eq!(checked, 7);
+    assert_eq!(checked, 8);
 }
 
 /// Every `const` of the assembled WGSL modules with a literal value, by name.
@@ -142,6 +142,11 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("LAW_SPRING_DASHPOT", layout::LAW_SPRING_DASHPOT as f64),
         ("LAW_CONTINUOUS", layout::LAW_CONTINUOUS as f64),
         ("LAW_AREA", layout::LAW_AREA as f64),
+        ("LAW_HERTZ", layout::LAW_HERTZ as f64),
+        ("MAX_SUB", talus::spheropolygon::MAX_SUB as f64),
+        ("VERTEX_I", talus::spheropolygon::VERTEX_I as f64),
+        ("VERTEX_J", talus::spheropolygon::VERTEX_J as f64),
+        ("VERTICES", talus::spheropolygon::VERTICES as f64),
         ("C_STEP", c::STEP as f64),
         ("C_LIVE", c::LIVE as f64),
         ("C_LOST", c::LOST as f64),

@@ -39,7 +39,7 @@ const fn bind(name: &'static str, group: u32, binding: u32, ty: &'static str) ->
 /// per-step array; group 1: the spring table; group 2: the indirect dispatch arguments
 /// (`plan_rebuild`, `plan_pairs` only: a buffer cannot be an indirect argument and
 /// writable storage in one dispatch).
-pub const BINDINGS: [Binding; 30] = [
+pub const BINDINGS: [Binding; 32] = [
     bind("params", 0, 0, "Params"),
     bind("state", 0, 1, "array<State>"),
     bind("props", 0, 2, "array<Props>"),
@@ -85,9 +85,14 @@ pub const BINDINGS: [Binding; 30] = [
     bind("contact_geo", 0, 26, "array<vec4<f32>>"),
     // Every candidate of the lists as one compact list (`PairList`, common.wgsl).
     bind("pairs", 0, 27, "PairList"),
+    // A spheropolygon pair's sub-contact springs per candidate slot (`SubSprings`,
+    // common.wgsl; one element unless the law is hertz_cohesive).
+    bind("sub_hist", 0, 28, "array<SubSprings>"),
     // The spring table keyed by pair: touched only at a rebuild of the lists, which
     // stores the old lists' springs into it and gathers the new lists' from it (issue 13).
     bind("table", 1, 0, "array<Entry>"),
+    // Beside each entry of the table, its pair's sub-contact springs (spheropolygons).
+    bind("table_sub", 1, 1, "array<SubSprings>"),
     // Per rebuild stage, its workgroups (plan.wgsl).
     bind("dispatch_args", 2, 0, "array<u32>"),
 ];

@@ -36,6 +36,9 @@ pub(super) struct Buffers {
     pub(super) props_next: wgpu::Buffer,
     pub(super) ids_next: wgpu::Buffer,
     pub(super) table: wgpu::Buffer,
+    /// Spheropolygons' sub-contact springs: per candidate slot, and beside the table.
+    pub(super) sub_hist: wgpu::Buffer,
+    pub(super) table_sub: wgpu::Buffer,
     /// The rebuild stages' indirect dispatch arguments (shaders/plan.wgsl).
     pub(super) dispatch_args: wgpu::Buffer,
     /// The candidates as one list (`PairList` in common.wgsl).
@@ -52,6 +55,7 @@ pub(super) struct Initial<'a> {
     pub(super) candidates: &'a [Candidate],
     pub(super) corners: &'a [[i32; 4]],
     pub(super) table: &'a [Entry],
+    pub(super) table_sub: &'a [SubSprings],
 }
 
 impl Buffers {
@@ -117,6 +121,13 @@ impl Buffers {
             props_next: zeroed("props_next", n * size_of::<Props>() as u64),
             ids_next: zeroed("ids_next", n * 4),
             table: init("springs", bytemuck::cast_slice(c.table)),
+            // Only spheropolygon scenes use them (32 bytes a slot).
+            sub_hist: {
+                let slots = if params.law == LAW_HERTZ { n * m } else { 1 };
+                let empty = vec![SubSprings::default(); slots as usize];
+                init("sub_hist", bytemuck::cast_slice(&empty))
+            },
+            table_sub: init("table_sub", bytemuck::cast_slice(c.table_sub)),
             dispatch_args: dev.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("dispatch_args"),
                 contents: bytemuck::cast_slice(&dispatch_args(params)),
@@ -125,9 +136,10 @@ impl Buffers {
                     | wgpu::BufferUsages::COPY_SRC,
             }),
             pairs: {
-                // The count, then a slot per candidate: only the overlap-area law takes a
-                // thread per pair (64 bytes a particle the disk laws do not need).
-                let slots = if params.law == LAW_AREA { n * m } else { 0 };
+                // The count, then a slot per candidate: only the overlap-area law and
+                // spheropolygons take a thread per pair (64 bytes a particle the disk
+                // laws do not need).
+                let slots = if per_pair(params) { n * m } else { 0 };
                 zeroed("pairs", 4 + slots * 4)
             },
         }
@@ -166,6 +178,8 @@ impl Buffers {
             "contact_geo" => &b.contact_geo,
             "pairs" => &b.pairs,
             "table" => &b.table,
+            "sub_hist" => &b.sub_hist,
+            "table_sub" => &b.table_sub,
             "dispatch_args" => &b.dispatch_args,
             _ => return None,
         })

@@ -68,8 +68,9 @@ impl GpuSimulation {
                 let (st, mut pr) = to_device(&one, self.origin, cell);
                 let first = self.corner_table.len();
                 pr[0].shape[0] = first as u32;
-                let corners = device_corners(&one.shape[0], &st, &pr_local(&pr[0]), unit);
-                self.corner_table.extend_from_slice(&one.shape[0]);
+                let block = transfer::corner_block(&one.shape[0], one.sweep[0]);
+                let corners = device_corners(&block, &st, &pr_local(&pr[0]), unit);
+                self.corner_table.extend_from_slice(&block);
                 let q = &self.gpu.queue;
                 q.write_buffer(
                     &self.buffers.state,
@@ -145,7 +146,7 @@ pub(super) fn upcoming(
     let mut source_rows = Vec::new();
     let mut candidates = Vec::new();
     // Polygon corners: every particle's in id order, then every candidate's.
-    let mut corner_table: Vec<[f64; 2]> = sim.particles.shape.iter().flatten().copied().collect();
+    let mut corner_table = transfer::corner_table(&sim.particles);
     let dt = sim.dt();
     for (spec, st) in specs.iter().zip(&sim.sources) {
         let list = source::upcoming(spec, st);
@@ -167,14 +168,15 @@ pub(super) fn upcoming(
             let due = source::due_step(source::due_time(spec, st.inserted + k as u32), dt);
             let shape = [corner_table.len() as u32, one.shape[0].len() as u32];
             let (turn, turn_rem) = orientation::split_angle(drawn.theta);
-            corner_table.extend_from_slice(&one.shape[0]);
+            corner_table.extend_from_slice(&transfer::corner_block(&one.shape[0], one.sweep[0]));
             candidates.push(Candidate {
                 anchor,
                 frac,
                 rem,
+                // The drawn velocity (the source's, plus its spread).
                 velocity: [
-                    (spec.velocity[0] * dt) as f32,
-                    (spec.velocity[1] * dt) as f32,
+                    (disk.velocity[0] * dt) as f32,
+                    (disk.velocity[1] * dt) as f32,
                 ],
                 radius: one.radius[0] as f32,
                 mass: one.mass[0] as f32,

@@ -16,6 +16,7 @@ const ORIENTATION: &str = include_str!("../../shaders/orientation.wgsl");
 const GEOMETRY: &str = include_str!("../../shaders/geometry.wgsl");
 const POLYGON: &str = include_str!("../../shaders/polygon.wgsl");
 const LAWS: &str = include_str!("../../shaders/laws.wgsl");
+const SPHEROPOLYGON: &str = include_str!("../../shaders/spheropolygon.wgsl");
 
 pub const MODULES: &[ModuleSource] = &[
     ModuleSource {
@@ -120,6 +121,7 @@ pub const MODULES: &[ModuleSource] = &[
             GEOMETRY,
             POLYGON,
             LAWS,
+            SPHEROPOLYGON,
             include_str!("../../shaders/contact_forces.wgsl"),
         ],
     },
@@ -332,6 +334,8 @@ pub struct Build {
     pub polygons: bool,
     pub disks: bool,
     pub walls: bool,
+    /// Spheropolygons (law hertz_cohesive): `SPHEROPOLYGONS` in polygon.wgsl.
+    pub swept: bool,
     /// A software adapter (lavapipe): `contact_forces` takes four pairs to a thread
     /// under the overlap-area law instead of one (`PAIRS_PER_THREAD`, plan.wgsl).
     pub software: bool,
@@ -362,6 +366,7 @@ impl Build {
             polygons,
             disks,
             walls: !sim.walls.is_empty(),
+            swept: matches!(sim.law, crate::law::ContactLaw::HertzCohesive(_)),
             software: adapter.device_type == wgpu::DeviceType::Cpu,
         }
     }
@@ -421,6 +426,7 @@ impl Pipelines {
                 let (module, entry) = k.entry();
                 let flag = |on: bool| if on { 1.0 } else { 0.0 };
                 let polygons = ("POLYGONS", flag(build.area_law));
+                let swept = ("SPHEROPOLYGONS", flag(build.swept));
                 let shapes = [
                     polygons,
                     ("POLYGON_SHAPES", flag(build.polygons)),
@@ -437,9 +443,9 @@ impl Pipelines {
                 );
                 let ahead = ("AHEAD", if k == Kernel::CorrectAhead { 1.0 } else { 0.0 });
                 let per_thread = [("PAIRS_PER_THREAD", if build.software { 4.0 } else { 1.0 })];
-                let with_record = [shapes[0], shapes[1], shapes[2], shapes[3], record];
+                let with_record = [shapes[0], shapes[1], shapes[2], shapes[3], swept, record];
                 let constants: &[(&str, f64)] = match module {
-                    "find_contacts" => &[polygons],
+                    "find_contacts" => &[polygons, swept],
                     "contact_forces" => &with_record,
                     "correct" => &[ahead],
                     "plan" if k == Kernel::PlanPairs => &per_thread,

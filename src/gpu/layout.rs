@@ -21,6 +21,7 @@ pub const SCAN_WG: u32 = 256;
 pub const LAW_SPRING_DASHPOT: u32 = 0;
 pub const LAW_CONTINUOUS: u32 = 1;
 pub const LAW_AREA: u32 = 2;
+pub const LAW_HERTZ: u32 = 3;
 
 /// Words of the control buffer (`C_*` in common.wgsl).
 pub mod control {
@@ -99,6 +100,8 @@ pub struct Params {
     pub skin: f32,
     /// 1: sort the particles in memory by cell at every rebuild (permute.wgsl).
     pub reorder: u32,
+    pub bond_g: f32,
+    pub d_c: f32,
 }
 
 /// Dynamic state of one particle: q[0] = (rem_x, rem_z, rem_θ, 0) and the scaled Gear
@@ -177,6 +180,24 @@ pub struct Entry {
     pub j: u32,
     pub value: f32,
     pub _pad: u32,
+}
+
+/// A spheropolygon pair's sub-contact springs on the device (`SubSprings` in
+/// common.wgsl; `spheropolygon::SubSprings` in f64): keys EMPTY past the last.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
+pub struct SubSprings {
+    pub key: [u32; 4],
+    pub xi: [f32; 4],
+}
+
+impl Default for SubSprings {
+    fn default() -> Self {
+        Self {
+            key: [EMPTY; 4],
+            xi: [0.0; 4],
+        }
+    }
 }
 
 #[repr(C)]
@@ -264,7 +285,9 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 unit,
                 inv_unit,
                 skin,
-                reorder
+                reorder,
+                bond_g,
+                d_c
             ]
         ),
         fields!(
@@ -294,6 +317,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
         ),
         fields!(Entry, "Entry", [i, j, value, _pad]),
         fields!(Source, "Source", [first, count, inserted, _pad]),
+        fields!(SubSprings, "SubSprings", [key, xi]),
         fields!(
             Candidate,
             "Candidate",

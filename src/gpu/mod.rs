@@ -115,6 +115,8 @@ pub struct DeviceState {
     pub states: Vec<State>,
     pub props: Vec<Props>,
     pub springs: Vec<Entry>,
+    /// Spheropolygons: each entry of `springs`' sub-contact springs (empty otherwise).
+    pub sub: Vec<SubSprings>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -166,6 +168,42 @@ pub fn max_particles(binding: u64) -> u64 {
     lo
 }
 
+/// What the GPU path cannot take of a spheropolygon scene (law hertz_cohesive): cores
+/// of more than two corners (spheropolygon.wgsl takes disks and rods, at most four
+/// sub-contacts a pair), and polygons without a sweep (the CPU path takes them as
+/// disks of their circumscribed radius).
+fn unsupported_spheropolygons(sim: &Simulation) -> Option<String> {
+    if !matches!(sim.law, ContactLaw::HertzCohesive(_)) {
+        return None;
+    }
+    let p = &sim.particles;
+    let mut wide = (0..p.len()).filter(|&i| p.shape[i].len() > 2 || (p.is_polygon(i) && !p.is_swept(i)));
+    if let Some(i) = wide.next() {
+        return Some(format!(
+            "particle {i} is a spheropolygon with a core of {} corners; the GPU path takes \
+             disks and rods (cores of at most two corners) under law hertz_cohesive",
+            p.shape[i].len()
+        ));
+    }
+    let polygon_source = sim.scene.particles.iter().any(|c| match c {
+        Creation::PointSource(s) => s.polygon.is_some(),
+        Creation::LatticePile(l) => l.polygon.is_some(),
+        Creation::Row(r) => r.polygon.is_some(),
+        Creation::Layered(l) => l.polygon.is_some(),
+        Creation::List(l) => l.polygon.is_some(),
+    });
+    polygon_source.then(|| {
+        "polygons under law hertz_cohesive are not on the GPU path; it takes disks and rods"
+            .to_string()
+    })
+}
+
+/// Whether `contact_forces` takes a thread per pair (the overlap-area law and
+/// spheropolygons: `POLYGONS`, `SPHEROPOLYGONS`) rather than one per particle.
+pub(crate) fn per_pair(params: &Params) -> bool {
+    params.law == LAW_AREA || params.law == LAW_HERTZ
+}
+
 fn ceil_div(a: u64, b: u64) -> u64 {
     a.div_ceil(b)
 }
@@ -192,11 +230,8 @@ impl GpuSimulation {
             sim,
             device: device_state,
         } = ckpt;
-        if matches!(sim.law, ContactLaw::HertzCohesive(_)) {
-            return Err(GpuError::Unsupported(
-                "spheropolygons (law hertz_cohesive: rods, cohesion) are not on the GPU path yet"
-                    .into(),
-            ));
+        if let Some(reason) = unsupported_spheropolygons(&sim) {
+            return Err(GpuError::Unsupported(reason));
         }
         let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);
         if !point_sources.is_empty() && !layered_specs.is_empty() {
@@ -264,12 +299,14 @@ impl GpuSimulation {
         let walls = device_walls(&sim.walls, origin, cell_size);
 
         let control = initial_control(sim.step, n_now, up.sources.len());
-        let (states, props, entries) = initial_state(&sim, device_state, origin, cell_size);
+        let (states, props, entries, subs) = initial_state(&sim, device_state, origin, cell_size);
         let mut state_all = vec![State::default(); n_cap as usize];
         state_all[..states.len()].copy_from_slice(&states);
         let mut props_all = vec![Props::default(); n_cap as usize];
         props_all[..props.len()].copy_from_slice(&props);
-        let table = build_table(&entries, table_cap as usize);
+        let swept = matches!(sim.law, ContactLaw::HertzCohesive(_));
+        let (table, table_sub) =
+            transfer::build_tables(&entries, swept.then_some(&subs[..]), table_cap as usize);
 
         let mut corners = device_corners(
             &up.corner_table,
@@ -287,6 +324,7 @@ impl GpuSimulation {
             candidates: &up.candidates,
             corners: &corners,
             table: &table,
+            table_sub: &table_sub,
         };
         let dev = &gpu.device;
         let buffers = Buffers::new(dev, &params, cells, &initial);

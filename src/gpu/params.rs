@@ -28,10 +28,16 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             p.gamma_t = l.eta_t as f32;
             p.clamp = 1;
         }
-        // Refused before a run (`GpuSimulation::resume_with_gpu`); tests of laws.wgsl
-        // never ask for it.
-        ContactLaw::HertzCohesive(_) => {
-            unreachable!("the GPU path refuses law hertz_cohesive before a run")
+        ContactLaw::HertzCohesive(l) => {
+            // γ^N, γ^T are rates: the kernels multiply them by the reduced mass.
+            p.law = LAW_HERTZ;
+            p.k_n = l.k_n as f32;
+            p.k_t = l.k_t as f32;
+            p.gamma_n = l.gamma_n as f32;
+            p.gamma_t = l.gamma_t as f32;
+            p.mu = l.mu as f32;
+            p.bond_g = l.bond_g as f32;
+            p.d_c = l.d_c as f32;
         }
         ContactLaw::Continuous(c) => {
             p.law = LAW_CONTINUOUS;

@@ -140,12 +140,12 @@ impl GpuSimulation {
     }
 
     /// Records the dispatches of one kernel (for tests of single stages). Under the
-    /// overlap-area law `contact_forces` takes a thread per pair: `plan_pairs` writes
+    /// overlap-area law and for spheropolygons `contact_forces` takes a thread per pair: `plan_pairs` writes
     /// its workgroups from the pairs the last rebuild listed, and it is dispatched with
     /// them (issue 14 item 5).
     pub fn encode_kernel(&self, pass: &mut wgpu::ComputePass, k: Kernel) {
         let per_pair = matches!(k, Kernel::ContactForces | Kernel::ContactForcesOnly)
-            && self.params.law == LAW_AREA;
+            && per_pair(&self.params);
         if per_pair {
             self.dispatch(pass, Kernel::PlanPairs, 1);
             self.dispatches.set(self.dispatches.get() + 1);

@@ -30,9 +30,33 @@ pub(super) fn wall_normal(w: &crate::geometry::WallSegment) -> ([i32; 2], f32, f
     (nq, beta as f32, alpha as f32)
 }
 
+/// Marks a spheropolygon's sweep radius in the host's corner table: the entry after its
+/// core's corners is (sweep, SWEEP_TAG) (spheropolygon.wgsl reads it there).
+pub const SWEEP_TAG: f64 = f64::INFINITY;
+
+/// A particle's entries in the corner table: its corners, then its sweep radius if it
+/// is a spheropolygon.
+pub fn corner_block(corners: &[[f64; 2]], sweep: f64) -> Vec<[f64; 2]> {
+    let mut b = corners.to_vec();
+    if sweep > 0.0 {
+        b.push([sweep, SWEEP_TAG]);
+    }
+    b
+}
+
+/// The device's entry of a sweep radius: whole units, and the remainder's bits.
+fn sweep_entry(sweep: f64, unit: f64) -> [i32; 4] {
+    let whole = (sweep / unit).round();
+    let rem = ((sweep - whole * unit) / unit) as f32;
+    let w = whole as i32;
+    let r = rem.to_bits() as i32;
+    [w, r, w, r]
+}
+
 /// The device's corner buffer: every corner in whole position units, body frame in xy
 /// and rotated to its particle's orientation in zw (as `rotate_corners` in
-/// orientation.wgsl; a candidate's are rotated when it is placed).
+/// orientation.wgsl; a candidate's are rotated when it is placed); a sweep radius
+/// (`SWEEP_TAG`) as `sweep_entry`.
 pub(super) fn device_corners(
     table: &[[f64; 2]],
     states: &[State],
@@ -42,6 +66,9 @@ pub(super) fn device_corners(
     let mut out: Vec<[i32; 4]> = table
         .iter()
         .map(|&v| {
+            if v[1] == SWEEP_TAG {
+                return sweep_entry(v[0], unit);
+            }
             let b = orientation::corner_units(v, unit);
             [b[0], b[1], b[0], b[1]]
         })
@@ -67,15 +94,22 @@ pub(super) fn pr_local(p: &Props) -> [Props; 1] {
     }]
 }
 
-/// Where each particle's corners start in the corner buffer: particles in id order.
+/// Where each particle's corners start in the corner buffer: particles in id order, each
+/// with its `corner_block`.
 pub fn corner_starts(p: &Particles) -> Vec<u32> {
-    p.shape
-        .iter()
-        .scan(0u32, |next, c| {
+    (0..p.len())
+        .scan(0u32, |next, i| {
             let start = *next;
-            *next += c.len() as u32;
+            *next += p.shape[i].len() as u32 + p.is_swept(i) as u32;
             Some(start)
         })
+        .collect()
+}
+
+/// Every particle's `corner_block`, in id order.
+pub fn corner_table(p: &Particles) -> Vec<[f64; 2]> {
+    (0..p.len())
+        .flat_map(|i| corner_block(&p.shape[i], p.sweep[i]))
         .collect()
 }
 
@@ -181,30 +215,73 @@ pub fn from_device(
         p.active.push(pr.flags & ACTIVE != 0);
         p.material.push(pr.flags >> 8);
         let [start, count] = pr.shape;
-        p.shape
-            .push(corner_table[start as usize..(start + count) as usize].to_vec());
-        // The GPU path refuses spheropolygons (`GpuSimulation::with_gpu`).
-        p.sweep.push(0.0);
+        let (start, end) = (start as usize, (start + count) as usize);
+        p.shape.push(corner_table[start..end].to_vec());
+        // A spheropolygon's sweep follows its corners (`corner_block`).
+        let sweep = match corner_table.get(end) {
+            Some(&[r, tag]) if count > 0 && tag == SWEEP_TAG => r,
+            _ => 0.0,
+        };
+        p.sweep.push(sweep);
     }
     p
 }
 
-/// A spring table laid out as the kernels expect (host twin of `insert_new`).
+/// A spring table laid out as the kernels expect (host twin of `insert` in
+/// store_history.wgsl).
 pub fn build_table(entries: &[Entry], cap: usize) -> Vec<Entry> {
+    build_tables(entries, None, cap).0
+}
+
+/// The spring table and its spheropolygon springs beside it (`table_sub`, of one
+/// element without `subs`; else `subs` gives each entry's, or none for an empty one).
+pub fn build_tables(
+    entries: &[Entry],
+    subs: Option<&[SubSprings]>,
+    cap: usize,
+) -> (Vec<Entry>, Vec<SubSprings>) {
     let empty = Entry {
         i: EMPTY,
         ..Default::default()
     };
     let mut t = vec![empty; cap];
+    let mut ts = vec![SubSprings::default(); if subs.is_some() { cap } else { 1 }];
+    let subs = subs.unwrap_or(&[]);
     let mask = cap - 1;
-    for e in entries {
+    for (k, e) in entries.iter().enumerate() {
         let mut slot = hash_pair(e.i, e.j) as usize & mask;
         while t[slot].i != EMPTY {
             slot = (slot + 1) & mask;
         }
         t[slot] = *e;
+        if let Some(sub) = subs.get(k) {
+            ts[slot] = *sub;
+        }
     }
-    t
+    (t, ts)
+}
+
+/// A pair's sub-contact springs in the device's layout (f32; keys EMPTY past the last).
+pub fn sub_to_device(s: &crate::spheropolygon::SubSprings) -> SubSprings {
+    let mut d = SubSprings::default();
+    for k in 0..s.count.min(4) {
+        d.key[k] = s.key[k];
+        d.xi[k] = s.xi[k] as f32;
+    }
+    d
+}
+
+/// The device's sub-contact springs back in f64.
+pub fn sub_from_device(d: &SubSprings) -> crate::spheropolygon::SubSprings {
+    let mut s = crate::spheropolygon::SubSprings::default();
+    for k in 0..4 {
+        if d.key[k] != EMPTY {
+            s.key[s.count] = d.key[k];
+            s.xi[s.count] = d.xi[k] as f64;
+            s.count += 1;
+        }
+    }
+    s
 }
 
 /// Looks a pair up in a device-layout table (host twin of `lookup_old`).
@@ -283,8 +360,14 @@ impl GpuSimulation {
         self.sim.step = self.step;
         self.sim.lost = self.lost_base + c[control::LOST] as u64;
         let mut table = SpringTable::with_capacity_for(ds.springs.len());
-        for e in &ds.springs {
-            table.insert(pair_key(Pair { i: e.i, j: e.j }), e.value as f64);
+        for (k, e) in ds.springs.iter().enumerate() {
+            let key = pair_key(Pair { i: e.i, j: e.j });
+            table.insert(key, e.value as f64);
+            if let Some(sub) = ds.sub.get(k).map(sub_from_device)
+                && sub.count > 0
+            {
+                table.sub.insert(key, sub);
+            }
         }
         self.sim.springs = table;
         let rows: Vec<Source> = self.read_buffer(&self.buffers.sources, 0, self.sources.len());
@@ -383,12 +466,24 @@ impl GpuSimulation {
         let cap = self.params.table_mask as usize + 1;
         self.flush_table();
         let table: Vec<Entry> = self.read_buffer(&self.buffers.table, 0, cap);
-        let mut springs: Vec<Entry> = table.into_iter().filter(|e| e.i != EMPTY).collect();
-        springs.sort_by_key(|e| (e.i, e.j));
+        // Spheropolygons: each entry's sub-contact springs, from beside it.
+        let swept = self.params.law == LAW_HERTZ;
+        let subs: Vec<SubSprings> = if swept {
+            self.read_buffer(&self.buffers.table_sub, 0, cap)
+        } else {
+            Vec::new()
+        };
+        let mut springs: Vec<(Entry, SubSprings)> = (table.into_iter().enumerate())
+            .filter(|(_, e)| e.i != EMPTY)
+            .map(|(k, e)| (e, subs.get(k).copied().unwrap_or_default()))
+            .collect();
+        springs.sort_by_key(|(e, _)| (e.i, e.j));
+        let (springs, sub): (Vec<Entry>, Vec<SubSprings>) = springs.into_iter().unzip();
         DeviceState {
             states,
             props,
             springs,
+            sub: if swept { sub } else { Vec::new() },
         }
     }
 
@@ -538,34 +633,45 @@ pub(super) fn device_walls(
 }
 
 /// The particles and springs to upload: a GPU checkpoint's exact device state, else the
-/// f64 state and spring table converted.
+/// f64 state and spring table converted (with the spheropolygon springs beside the
+/// entries: empty when there are none).
 pub(super) fn initial_state(
     sim: &Simulation,
     device_state: Option<DeviceState>,
     origin: [f64; 2],
     cell_size: f32,
-) -> (Vec<State>, Vec<Props>, Vec<Entry>) {
+) -> (Vec<State>, Vec<Props>, Vec<Entry>, Vec<SubSprings>) {
     match device_state {
         Some(mut ds) => {
             // The corner buffer is laid out afresh: point each particle at its corners.
             for (pr, start) in ds.props.iter_mut().zip(corner_starts(&sim.particles)) {
                 pr.shape[0] = start;
             }
-            (ds.states, ds.props, ds.springs)
+            (ds.states, ds.props, ds.springs, ds.sub)
         }
         None => {
             let (s, p) = to_device(&sim.particles, origin, cell_size);
-            let e = sim
-                .spring_table()
-                .entries()
-                .map(|(k, v)| Entry {
-                    i: (k >> 32) as u32,
-                    j: k as u32,
-                    value: v as f32,
-                    _pad: 0,
-                })
-                .collect();
-            (s, p, e)
+            let table = sim.spring_table();
+            let entry = |k: u64, v: f64| Entry {
+                i: (k >> 32) as u32,
+                j: k as u32,
+                value: v as f32,
+                _pad: 0,
+            };
+            let mut e: Vec<Entry> = table.entries().map(|(k, v)| entry(k, v)).collect();
+            let mut subs = Vec::new();
+            if !table.sub.is_empty() {
+                // Every pair with sub-contact springs has an entry, its springs beside it.
+                let mut by_key: std::collections::BTreeMap<u64, (f64, SubSprings)> = (e.iter())
+                    .map(|x| ((x.i as u64) << 32 | x.j as u64, (x.value as f64, SubSprings::default())))
+                    .collect();
+                for (&k, sub) in &table.sub {
+                    by_key.entry(k).or_insert((0.0, SubSprings::default())).1 = sub_to_device(sub);
+                }
+                e = by_key.iter().map(|(&k, &(v, _))| entry(k, v)).collect();
+                subs = by_key.into_values().map(|(_, s)| s).collect();
+            }
+            (s, p, e, subs)
         }
     }
 }
