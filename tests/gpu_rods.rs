@@ -163,3 +163,110 @@ fn cohesive_rod_contacts_and_their_springs_match_the_cpu_over_rebuilds() {
     eprintln!("{test}: {} pairs' springs, worst {worst:.1e} of the largest", cs.len());
     assert!(worst < 2e-3, "springs differ by {worst:.2e} of the largest");
 }
+
+/// A short box deposition (paper 004's setup, reduced): 16 cohesive rods (d = 3,
+/// Bo = 10) poured from a point source with random initial velocities and orientations
+/// into a box 20 wide, leapfrog as in R9.
+fn rod_deposition() -> talus::scene::Scene {
+    let v = json!({
+        "name": "rod-deposition", "dt": 2e-4, "integrator": "leapfrog", "seed": 5,
+        "stop": { "time": 10.0 },
+        "gravity": { "g": [0.0, -10.0] },
+        "domain": { "x": [-12.0, 12.0], "z": [-2.0, 20.0] },
+        "materials": { "rod": { "density": 1.0 } },
+        "contact": { "law": "hertz_cohesive", "k_n": 1.0e5, "k_t": 1.0e4, "gamma_n": 30.0,
+                     "gamma_t": 10.0, "mu": 0.5, "bond": 10.0, "d_c": 1.0e-4 },
+        "walls": [{ "from": [-10.0, 0.0], "to": [10.0, 0.0] },
+                  { "from": [-10.0, 0.0], "to": [-10.0, 15.0] },
+                  { "from": [10.0, 0.0], "to": [10.0, 15.0] }],
+        "particles": [{ "kind": "point_source", "material": "rod", "rod": { "aspect": 3.0 },
+                        "position": [0.0, 10.0], "spread": 8.0, "rate": 8.0, "count": 16,
+                        "diameter": 1.0, "velocity": [0.0, -5.0], "velocity_spread": 1.0 }],
+        "output": { "checkpoint_every": 0 }
+    });
+    common::parse(&v)
+}
+
+#[test]
+fn a_rod_deposition_agrees_with_the_cpu() {
+    // Insertions with drawn velocities and orientations, free fall, impacts on the floor
+    // and cohesive contacts between rods: both paths step by step, f32 against f64.
+    let test = "a_rod_deposition_agrees_with_the_cpu";
+    let Some(gpu) = common::gpu(test) else { return };
+    let mut g = GpuSimulation::with_gpu(Simulation::new(rod_deposition()).unwrap(), gpu).unwrap();
+    let mut cpu = Simulation::new(rod_deposition()).unwrap();
+    // Step by step through the insertions and the first impacts (to t = 2 s) ...
+    let (mut worst, mut impacts) = (0.0f64, 0);
+    for _ in 0..50 {
+        g.advance(200).unwrap();
+        (0..200).for_each(|_| cpu.step().unwrap());
+        let gs = g.download();
+        assert_eq!(gs.particles.len(), cpu.particles.len(), "same insertions");
+        for i in 0..cpu.particles.len() {
+            let (a, b) = (gs.particles.position(i), cpu.particles.position(i));
+            worst = worst.max((a[0] - b[0]).hypot(a[1] - b[1]));
+        }
+        impacts = impacts.max(cpu.contacts.len());
+    }
+    // ... then, as the deposit forms and f32 against f64 parts the two chaotic runs, in
+    // their statistics: the rods' centre of mass and the contacts.
+    g.advance(5000).unwrap();
+    (0..5000).for_each(|_| cpu.step().unwrap());
+    let (gs, n) = (g.download(), cpu.particles.len());
+    let com = |s: &Simulation| {
+        let p = &s.particles;
+        let m: f64 = p.mass.iter().sum();
+        [0, 1].map(|k| (0..p.len()).map(|i| p.mass[i] * p.position(i)[k]).sum::<f64>() / m)
+    };
+    let (ca, cb) = (com(gs), com(&cpu));
+    eprintln!(
+        "{test}: {n} rods; to step 10000 (up to {impacts} contacts) positions within {worst:.1e} \
+         widths; at step 15000 {} against {} contacts, centre of mass ({:.3}, {:.3}) against \
+         ({:.3}, {:.3})",
+        gs.contacts.len(),
+        cpu.contacts.len(),
+        ca[0],
+        ca[1],
+        cb[0],
+        cb[1]
+    );
+    assert_eq!(n, 16, "every rod was poured");
+    assert!(impacts > 3, "rods have reached the floor by step 10000");
+    // Measured: 1.1e-5 widths (after the first impacts; 1e-6 before).
+    assert!(worst < 1e-4, "positions differ by {worst:.2e} widths");
+    assert!(cpu.contacts.len() > 12, "the rods lie in a deposit");
+    assert!((ca[0] - cb[0]).abs() < 0.5 && (ca[1] - cb[1]).abs() < 0.2, "centre of mass");
+    let (a, b) = (gs.contacts.len() as f64, cpu.contacts.len() as f64);
+    assert!((a - b).abs() <= 0.2 * b, "contacts");
+}
+
+#[test]
+fn gpu_rod_runs_resume_bitwise() {
+    // The sub-contact springs go through the checkpoint's device section.
+    let test = "gpu_rod_runs_resume_bitwise";
+    let Some(gpu) = common::gpu(test) else { return };
+    let steps = 15000;
+    let mut a = GpuSimulation::with_gpu(Simulation::new(rod_deposition()).unwrap(), gpu).unwrap();
+    a.advance(steps).unwrap();
+    let gpu = common::gpu(test).unwrap();
+    let mut b = GpuSimulation::with_gpu(Simulation::new(rod_deposition()).unwrap(), gpu).unwrap();
+    b.advance(steps / 2).unwrap();
+    let (sim, device) = b.checkpoint_state();
+    let bytes = talus::checkpoint::encode(sim, device);
+    let dir = std::env::temp_dir().join(format!("talus-gpu-rods-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("ckpt.bin");
+    std::fs::write(&path, bytes).unwrap();
+    let loaded = talus::checkpoint::read(&path, &[]).unwrap();
+    let ds = loaded.device.as_ref().expect("a GPU checkpoint carries the device state");
+    assert!(
+        ds.sub.iter().any(|s| s.key[0] != u32::MAX),
+        "the checkpoint holds sub-contact springs"
+    );
+    let mut c = GpuSimulation::resume_with_gpu(loaded, common::gpu(test).unwrap()).unwrap();
+    c.advance(steps - steps / 2).unwrap();
+    let (sa, sc) = (a.device_state(), c.device_state());
+    assert!(sa.states.len() == 16, "{} rods", sa.states.len());
+    assert!(sa == sc, "the resumed GPU run differs from the uninterrupted one");
+    std::fs::remove_dir_all(&dir).ok();
+}

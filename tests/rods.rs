@@ -1,7 +1,8 @@
-//! Rods (spheropolygons, paper 004, SPEC 2.4) on the CPU path: static loads against
-//! Hertz's k δ^{3/2} = F, cohesion that holds a rod up against gravity or lets it go,
-//! and results that depend neither on the thread count nor on when the neighbour lists
-//! are rebuilt (the sub-contact springs move with their slots).
+//! Rods (spheropolygons, paper 004, SPEC 2.4): static loads against Hertz's
+//! k δ^{3/2} = F and cohesion that holds a rod up against gravity or lets it go, on both
+//! paths (the GPU's f32 forces to 1e-5 of δ, the CPU's f64 to 1e-6); and on the CPU
+//! path, results that depend neither on the thread count nor on when the neighbour
+//! lists are rebuilt (the sub-contact springs move with their slots).
 
 mod common;
 use common::*;
@@ -40,10 +41,25 @@ fn rods(contact_extra: Value, rods: Value, walls: bool) -> Value {
 }
 
 fn settle(v: &Value, time: f64) -> Simulation {
-    let mut s = sim(v);
+    settle_on(Path::Cpu, v, time).expect("the CPU path runs")
+}
+
+/// `settle` on either path (None: no GPU adapter, skipped with a message).
+fn settle_on(path: Path, v: &Value, time: f64) -> Option<Simulation> {
+    let s = sim(v);
     let steps = (time / s.dt()).round() as u64;
-    s.advance(steps).expect("the rods settle");
-    s
+    let mut e = engine(path, "rods", s)?;
+    e.advance(steps).expect("the rods settle");
+    Some(e.sim().clone())
+}
+
+/// How close each path comes to the analytic overlaps: f64 on the CPU, f32 forces on
+/// the GPU (positions themselves are fixed point on both).
+fn tolerance(path: Path) -> f64 {
+    match path {
+        Path::Cpu => 1e-6,
+        Path::Gpu => 1e-5,
+    }
 }
 
 #[test]
@@ -53,18 +69,20 @@ fn a_rod_on_its_flat_side_rests_on_two_points_carrying_half_its_weight_each() {
         json!([{ "position": [0.0, 0.5], "diameter": 1.0 }]),
         true,
     );
-    let s = settle(&v, 3.0);
-    let m = rod_mass();
-    assert!((s.particles.mass[0] - m).abs() < 1e-12 * m);
-    // Each end: k δ^{3/2} = m g / 2.
-    let delta = (0.5 * m * G / K_N).powf(2.0 / 3.0);
-    let q = s.particles.q[0][0];
-    let overlap = 0.5 - q[1];
-    assert!(
-        (overlap - delta).abs() < 1e-6 * delta,
-        "overlap {overlap} against {delta}"
-    );
-    assert!(q[0].abs() < 1e-12 && q[2].abs() < 1e-12, "{q:?}");
+    for path in PATHS {
+        let Some(s) = settle_on(path, &v, 3.0) else { continue };
+        let m = rod_mass();
+        assert!((s.particles.mass[0] - m).abs() < 1e-6 * m);
+        // Each end: k δ^{3/2} = m g / 2.
+        let delta = (0.5 * m * G / K_N).powf(2.0 / 3.0);
+        let q = s.particles.q[0][0];
+        let overlap = 0.5 - q[1];
+        assert!(
+            (overlap - delta).abs() < tolerance(path) * delta,
+            "{path:?}: overlap {overlap} against {delta}"
+        );
+        assert!(q[0].abs() < 1e-9 && q[2].abs() < 1e-9, "{path:?}: {q:?}");
+    }
 }
 
 #[test]
@@ -75,13 +93,15 @@ fn a_rod_on_its_tip_rests_on_one_point_carrying_its_whole_weight() {
         json!([{ "position": [0.0, 1.5], "diameter": 1.0, "theta": half }]),
         true,
     );
-    let s = settle(&v, 3.0);
-    let delta = (rod_mass() * G / K_N).powf(2.0 / 3.0);
-    let overlap = 1.5 - s.particles.q[0][0][1];
-    assert!(
-        (overlap - delta).abs() < 1e-6 * delta,
-        "overlap {overlap} against {delta}"
-    );
+    for path in PATHS {
+        let Some(s) = settle_on(path, &v, 3.0) else { continue };
+        let delta = (rod_mass() * G / K_N).powf(2.0 / 3.0);
+        let overlap = 1.5 - s.particles.q[0][0][1];
+        assert!(
+            (overlap - delta).abs() < tolerance(path) * delta,
+            "{path:?}: overlap {overlap} against {delta}"
+        );
+    }
 }
 
 #[test]
@@ -96,24 +116,27 @@ fn a_rod_on_another_loads_both_points_of_each_contact_equally() {
         ]),
         true,
     );
-    let s = settle(&v, 3.0);
-    let m = rod_mass();
-    let (low, high) = (
-        (m * G / K_N).powf(2.0 / 3.0),
-        (0.5 * m * G / K_N).powf(2.0 / 3.0),
-    );
-    let z = [s.particles.q[0][0][1], s.particles.q[0][1][1]];
-    assert!((0.5 - z[0] - low).abs() < 1e-6 * low, "{z:?}");
-    assert!((z[0] + 1.0 - z[1] - high).abs() < 1e-6 * high, "{z:?}");
-    assert!(
-        s.particles.q[0][1][2].abs() < 1e-12,
-        "no torque: the two points are equal"
-    );
+    for path in PATHS {
+        let Some(s) = settle_on(path, &v, 3.0) else { continue };
+        let m = rod_mass();
+        let (low, high) = (
+            (m * G / K_N).powf(2.0 / 3.0),
+            (0.5 * m * G / K_N).powf(2.0 / 3.0),
+        );
+        let tol = tolerance(path);
+        let z = [s.particles.q[0][0][1], s.particles.q[0][1][1]];
+        assert!((0.5 - z[0] - low).abs() < tol * low, "{path:?}: {z:?}");
+        assert!((z[0] + 1.0 - z[1] - high).abs() < tol * high, "{path:?}: {z:?}");
+        assert!(
+            s.particles.q[0][1][2].abs() < 1e-9,
+            "{path:?}: no torque: the two points are equal"
+        );
+    }
 }
 
 /// A rod hanging under a fixed one, parallel and just touching, with Bond number `bond`;
-/// returns its height after a second.
-fn hanging(bond: f64) -> f64 {
+/// returns its height after a second (None: no GPU).
+fn hanging(path: Path, bond: f64) -> Option<f64> {
     let v = rods(
         json!({ "bond": bond }),
         json!([
@@ -122,8 +145,8 @@ fn hanging(bond: f64) -> f64 {
         ]),
         false,
     );
-    let s = settle(&v, 1.0);
-    s.particles.q[0][1][1]
+    let s = settle_on(path, &v, 1.0)?;
+    Some(s.particles.q[0][1][1])
 }
 
 #[test]
@@ -133,15 +156,17 @@ fn cohesion_holds_a_rod_up_against_gravity_and_lets_it_go_when_weaker() {
     let m = rod_mass();
     let bond = 1.0;
     let delta = ((bond - 0.5) * m * G / K_N).powf(2.0 / 3.0);
-    let z = hanging(bond);
-    assert!(
-        (z - (-1.0 + delta)).abs() < 1e-6 * delta,
-        "height {z} against {}",
-        -1.0 + delta
-    );
-    // 2 F_c = 0.4 m g cannot hold it: after a second it has fallen ~ g/2 (1 − 0.4).
-    let z = hanging(0.2);
-    assert!(z < -3.0, "height {z}: the rod fell");
+    for path in PATHS {
+        let Some(z) = hanging(path, bond) else { continue };
+        assert!(
+            (z - (-1.0 + delta)).abs() < tolerance(path) * delta,
+            "{path:?}: height {z} against {}",
+            -1.0 + delta
+        );
+        // 2 F_c = 0.4 m g cannot hold it: after a second it has fallen ~ g/2 (1 − 0.4).
+        let z = hanging(path, 0.2).expect("ran above");
+        assert!(z < -3.0, "{path:?}: height {z}: the rod fell");
+    }
 }
 
 fn pile(skin: Option<f64>) -> Value {
