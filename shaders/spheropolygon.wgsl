@@ -306,8 +306,9 @@ fn wall_subs(i: u32, w: u32, gap: f32) -> Subs {
 
 // The force of spheropolygon candidate `slot` of particle i (src/forces.rs
 // `spheropolygon_candidate`): every sub-contact under the law with its own spring from
-// the slot's `sub_hist`, summed into the candidate's force and torques; the deepest
-// sub-contact stands for the pair in the outputs.
+// the slot's `sub_hist`, summed into the candidate's force and torques. In the outputs
+// the pair has the deepest sub-contact's normal and overlap, at the centre of its
+// sub-contacts' normal forces.
 fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
     let j = contact_j[slot];
     let wall = j >= WALL_BASE;
@@ -349,6 +350,10 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
     var torque = vec2<f32>(0.0);
     var energy = 0.0;
     var deepest = 0u;
+    // The centre of the sub-contacts' normal forces (src/forces.rs `centre_of_forces`).
+    var weight = 0.0;
+    var weight_abs = 0.0;
+    var centre = vec2<f32>(0.0);
     for (var k = 0u; k < subs.count; k++) {
         let key = subs.key[k];
         let n = subs.n[k];
@@ -370,6 +375,9 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
         f += fk;
         torque += vec2<f32>(cross2(l1, fk), -cross2(l2, fk));
         energy += r.energy;
+        weight += r.f_n;
+        weight_abs += abs(r.f_n);
+        centre += r.f_n * l1;
         springs.key[k] = key;
         springs.xi[k] = r.history;
         if (subs.delta[k] > subs.delta[deepest]) { deepest = k; }
@@ -383,7 +391,9 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
     if (too_deep) { halt(HALT_OVERLAP, i); }
     if (RECORD || !finite || too_deep) {
         let n = subs.n[deepest];
+        var arm = subs.point[deepest] * u;
+        if (abs(weight) > 1.0e-6 * weight_abs) { arm = centre / weight; }
         contact_info[slot] = vec4<f32>(dot(f, n), dot(f, tangent(n)), delta, energy);
-        contact_geo[slot] = vec4<f32>(n, subs.point[deepest] * u);
+        contact_geo[slot] = vec4<f32>(n, arm);
     }
 }

@@ -18,7 +18,7 @@ use crate::overlap::{
     AreaContact, disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall,
 };
 use crate::shape::RotatedCorners;
-use crate::spheropolygon::SubSprings;
+use crate::spheropolygon::{SubContact, SubSprings};
 use crate::springs::pair_key;
 use crate::state::{Dof, Particles};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -284,7 +284,8 @@ pub fn candidate_forces(
 /// force is the sum over its sub-contacts (`spheropolygon::pair_force`), each with its
 /// spring from the list's slot (`NeighbourList::sub_history`). A disk is a point core
 /// swept by its radius; a wall a segment of sweep 0. When recording, a pair is reported
-/// as one contact: its total force at its deepest sub-contact's point and normal.
+/// as one contact: its total force, at the centre of its sub-contacts' normal forces
+/// (`centre_of_forces`), with its deepest sub-contact's normal and overlap.
 fn spheropolygon_candidates(
     s: &StepState,
     law: &HertzCohesive,
@@ -403,12 +404,13 @@ fn spheropolygon_candidate(
     };
     let t = tangent(deepest.n);
     let pos = p.position(i);
+    let arm = centre_of_forces(&f.contacts).unwrap_or(deepest.arm);
     let c = ContactForce {
         force: f.force,
         // ContactForce's second torque is about j's centre, arm' × F (on j: minus that).
         torque: [f.torque[0], -f.torque[1]],
-        point: [pos[0] + deepest.arm[0], pos[1] + deepest.arm[1]],
-        arm: deepest.arm,
+        point: [pos[0] + arm[0], pos[1] + arm[1]],
+        arm,
         n: deepest.n,
         f_n: f.force[0] * deepest.n[0] + f.force[1] * deepest.n[1],
         f_t: f.force[0] * t[0] + f.force[1] * t[1],
@@ -416,6 +418,22 @@ fn spheropolygon_candidate(
         energy: f.contacts.iter().map(|(_, r)| r.energy).sum(),
     };
     (Some(c), f.springs)
+}
+
+/// The point a spheropolygon pair is reported at: its sub-contacts' points weighted by
+/// their normal forces. Where the sub-contacts' forces are parallel (rods side by side:
+/// one normal) the pair's Σ f ⊗ l and torque are then exactly those of its total force
+/// at that point, so the stress of each grain (paper 000 eq. 8) is that of its
+/// sub-contacts. None when the forces cancel (then: the deepest sub-contact's point).
+/// Twin of the weighting in spheropolygon.wgsl `spheropolygon_force`.
+fn centre_of_forces(subs: &[(SubContact, crate::law::ContactOutput)]) -> Option<[f64; 2]> {
+    let (mut w, mut total, mut p) = (0.0, 0.0, [0.0; 2]);
+    for (c, r) in subs {
+        w += r.f_n;
+        total += r.f_n.abs();
+        p = [p[0] + r.f_n * c.arm[0], p[1] + r.f_n * c.arm[1]];
+    }
+    (w.abs() > 1e-6 * total).then(|| [p[0] / w, p[1] / w])
 }
 
 fn candidates_with<L: Law>(

@@ -72,7 +72,7 @@ fn v(name: &str, scene: &'static str, overrides: &[&str], window: f64, row: f64)
     }
 }
 
-/// The runs of reproduction `id` (R1–R9; R9 reduced only).
+/// The runs of reproduction `id` (R1–R9).
 pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
     let r7 = |name: &str, scene: &'static str| v(name, scene, &[], 14.0, 2.0);
     let lattice = |name: &str, set: Vec<String>| {
@@ -244,39 +244,77 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
                 x
             })
             .collect(),
-        // R9 reduced (paper 004): 300 rods per run instead of 6000, fed into a box 20 d
-        // wide, Bond numbers 0, 10² and 10³ (the paper's 10⁴ would press the contacts of
-        // k^N = 10⁷ by a fifth of a width: it needs a stiffer law and a smaller step).
-        "R9" if !full => {
+        // R9 (paper 004): rods of aspect d poured into a box 20 d wide. Reduced: 300 rods
+        // per run, Bond numbers 0, 10² and 10³. Full: the paper's 6000 rods, d ∈ {2, 5,
+        // 10} × Bo ∈ {0, 10³, 10⁴}; at Bo = 10⁴ the cohesive pull of k^N = 10⁷ would
+        // press contacts by a fifth of a width, so those runs take k^N, k^T 100 times
+        // stiffer (δ ~ 10⁻² width) and a step 6 times smaller (the contact time goes as
+        // k^(−2/5)).
+        "R9" => {
             let rods = |d: f64, bond: f64| {
                 let half = 10.0 * d;
                 let mut x = v(&format!("d{d}-bo{bond}"), R9_REDUCED, &[], 4.0 * d, 2.0 * d);
+                // The box's height and the source: above the deposit the run can build
+                // (6000 rods of area (d − 1) + π/4 at a packing fraction of ~0.7).
+                let (top, source) = if full {
+                    let deposit = 6000.0 * (d - 1.0 + 0.25 * PI) / (0.7 * 2.0 * half);
+                    let top = (deposit + 4.0 * d + 20.0).ceil();
+                    (top, top - d - 2.0)
+                } else {
+                    (70.0, 50.0)
+                };
                 x.overrides = vec![
                     format!("particles[0].rod.aspect={d}"),
                     format!("particles[0].spread={}", half - 0.5 * d - 1.0),
+                    format!("particles[0].position=[0,{source}]"),
                     format!("contact.bond={bond}"),
                     format!("domain.x=[{},{}]", -half - 5.0, half + 5.0),
+                    format!("domain.z=[-5,{}]", top + 10.0),
                     format!("walls[0].from=[{},0]", -half),
                     format!("walls[0].to=[{half},0]"),
                     format!("walls[1].from=[{},0]", -half),
-                    format!("walls[1].to=[{},70]", -half),
+                    format!("walls[1].to=[{},{top}]", -half),
                     format!("walls[2].from=[{half},0]"),
-                    format!("walls[2].to=[{half},70]"),
+                    format!("walls[2].to=[{half},{top}]"),
                 ];
+                if full {
+                    // 6000 rods due at 60 a second and thrown down at 50 widths a second;
+                    // a rod waits until the outlet is free within its circumscribed
+                    // circle, which limits the feed (for d = 10, to ~20 a second).
+                    x.overrides.extend([
+                        "particles[0].count=6000".to_string(),
+                        "particles[0].rate=60".to_string(),
+                        "particles[0].velocity=[0,-50]".to_string(),
+                        "stop.time=800".to_string(),
+                        format!("output.snapshot_every={}", 50.0),
+                    ]);
+                    if bond >= 1e4 {
+                        x.overrides.extend([
+                            "contact.k_n=1e9".to_string(),
+                            "contact.k_t=1e8".to_string(),
+                            "dt=2.5e-5".to_string(),
+                        ]);
+                    }
+                }
                 x
             };
-            vec![
-                rods(2.0, 0.0),
-                rods(5.0, 0.0),
-                rods(10.0, 0.0),
-                rods(5.0, 100.0),
-                rods(5.0, 1000.0),
-            ]
-        }
-        "R9" => {
-            return Err(format!(
-                "{id}: only the reduced R9 is built (300 rods per run; drop --full)"
-            ));
+            if full {
+                let mut all = Vec::new();
+                for d in [2.0, 5.0, 10.0] {
+                    for bond in [0.0, 1e3, 1e4] {
+                        all.push(rods(d, bond));
+                    }
+                }
+                all
+            } else {
+                vec![
+                    rods(2.0, 0.0),
+                    rods(5.0, 0.0),
+                    rods(10.0, 0.0),
+                    rods(5.0, 100.0),
+                    rods(5.0, 1000.0),
+                ]
+            }
         }
         _ => return Err(format!("unknown reproduction `{id}`: R1 to R9")),
     })
@@ -315,6 +353,7 @@ pub fn r9_trends(found: &[Findings]) -> Vec<String> {
                 ("d10-bo0", "d = 10"),
             ],
         ),
+        // Reduced: Bo = 0, 10², 10³; full: 0, 10³, 10⁴.
         trend(
             "Bo at d = 5",
             &[
@@ -322,7 +361,17 @@ pub fn r9_trends(found: &[Findings]) -> Vec<String> {
                 ("d5-bo100", "Bo = 100"),
                 ("d5-bo1000", "Bo = 1000"),
             ],
-        ),
+        )
+        .or_else(|| {
+            trend(
+                "Bo at d = 5",
+                &[
+                    ("d5-bo0", "Bo = 0"),
+                    ("d5-bo1000", "Bo = 1000"),
+                    ("d5-bo10000", "Bo = 10000"),
+                ],
+            )
+        }),
     ]
     .into_iter()
     .flatten()
@@ -732,7 +781,7 @@ mod tests {
             .collect();
         let lying = orientation_fraction(&uniform, |t| t.min(PI - t) < 20f64.to_radians());
         assert!((lying - 4.0 / 18.0).abs() < 1e-12, "{lying}");
-        assert!(variants("R9", false).unwrap().len() == 5 && variants("R9", true).is_err());
+        assert!(variants("R9", false).unwrap().len() == 5 && variants("R9", true).unwrap().len() == 9);
     }
 
     #[test]

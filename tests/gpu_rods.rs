@@ -72,13 +72,17 @@ fn random_rods(rows: usize, cols: usize, bond: f64, seed: u64) -> Value {
     v
 }
 
-/// Each contact by pair: force (x, z), torque on i, torque about j, overlap.
-fn by_pair(s: &Simulation) -> BTreeMap<(u32, u32), [f64; 5]> {
+/// Each contact by pair: force (x, z), torque on i, torque about j, overlap, and the
+/// point it is reported at relative to i's centre.
+fn by_pair(s: &Simulation) -> BTreeMap<(u32, u32), [f64; 7]> {
     (s.pairs.iter().zip(&s.contacts))
         .map(|(p, c)| {
             (
                 (p.i, p.j),
-                [c.force[0], c.force[1], c.torque[0], c.torque[1], c.overlap],
+                [
+                    c.force[0], c.force[1], c.torque[0], c.torque[1], c.overlap, c.arm[0],
+                    c.arm[1],
+                ],
             )
         })
         .collect()
@@ -94,27 +98,29 @@ fn assert_contacts_agree(test: &str, v: &Value, steps: u64, tol: f64, least: usi
     (0..steps).for_each(|_| cpu.step().unwrap());
     let gs = g.download();
     let (a, b) = (by_pair(gs), by_pair(&cpu));
-    let keys = |m: &BTreeMap<(u32, u32), [f64; 5]>| m.keys().copied().collect::<Vec<_>>();
+    let keys = |m: &BTreeMap<(u32, u32), [f64; 7]>| m.keys().copied().collect::<Vec<_>>();
     assert_eq!(keys(&a), keys(&b), "{test}: the contact lists differ");
     let f_max = b.values().map(|c| c[0].hypot(c[1])).fold(0.0, f64::max);
     let t_max = b.values().map(|c| c[2].abs().max(c[3].abs())).fold(0.0, f64::max);
-    let (mut df, mut dt, mut dd) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut df, mut dt, mut dd, mut dp) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let d_max = b.values().map(|c| c[4].abs()).fold(0.0, f64::max);
     for (k, c) in &b {
         let g = a[k];
         df = df.max((g[0] - c[0]).hypot(g[1] - c[1]) / f_max);
         dt = dt.max((g[2] - c[2]).abs().max((g[3] - c[3]).abs()) / t_max);
         dd = dd.max((g[4] - c[4]).abs() / d_max);
+        dp = dp.max((g[5] - c[5]).hypot(g[6] - c[6]));
     }
     eprintln!(
         "{test}: {} contacts after {steps} steps; forces {df:.1e}, torques {dt:.1e} of the \
-         largest, overlaps {dd:.1e} of the deepest",
+         largest, overlaps {dd:.1e} of the deepest, points {dp:.1e} widths",
         b.len()
     );
     assert!(b.len() >= least, "{test}: the scene is in contact ({})", b.len());
     assert!(df < tol, "{test}: forces differ by {df:.2e} of the largest");
     assert!(dt < tol, "{test}: torques differ by {dt:.2e} of the largest");
     assert!(dd < tol, "{test}: overlaps differ by {dd:.2e} of the deepest");
+    assert!(dp < tol, "{test}: contact points differ by {dp:.2e} widths");
 }
 
 #[test]

@@ -131,6 +131,17 @@ fn a_rod_on_another_loads_both_points_of_each_contact_equally() {
             s.particles.q[0][1][2].abs() < 1e-9,
             "{path:?}: no torque: the two points are equal"
         );
+        // The pair is reported at the centre of its two equal sub-contact forces, so
+        // its Σ f ⊗ l is theirs: above the rods' centres, in the middle of their overlap.
+        let k = (s.pairs.iter())
+            .position(|p| (p.i, p.j) == (0, 1))
+            .expect("the rods touch");
+        let c = &s.contacts[k];
+        assert!(
+            c.point[0].abs() < 1e-6 && (c.point[1] - 0.5 * (z[0] + z[1])).abs() < 1e-6,
+            "{path:?}: the pair's point {:?}",
+            c.point
+        );
     }
 }
 
