@@ -781,7 +781,9 @@ mod tests {
             .collect();
         let lying = orientation_fraction(&uniform, |t| t.min(PI - t) < 20f64.to_radians());
         assert!((lying - 4.0 / 18.0).abs() < 1e-12, "{lying}");
-        assert!(variants("R9", false).unwrap().len() == 5 && variants("R9", true).unwrap().len() == 9);
+        assert!(
+            variants("R9", false).unwrap().len() == 5 && variants("R9", true).unwrap().len() == 9
+        );
     }
 
     #[test]

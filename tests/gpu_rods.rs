@@ -22,14 +22,14 @@ fn random_rods(rows: usize, cols: usize, bond: f64, seed: u64) -> Value {
     // Each column's top: rows rest on each other with overlaps of ~0.005 width.
     let mut top = vec![0.0f64; cols];
     for r in 0..rows {
-        for c in 0..cols {
+        for (c, top) in top.iter_mut().enumerate() {
             let x = 3.0 + c as f64 * pitch + rng.range(-0.1, 0.1);
             let width = rng.range(0.9, 1.0);
             // Upright rods on top, standing on an end on the rods below them.
             let upright = r + 1 == rows && c % 2 == 1;
             let half = if upright { 2.0 * width } else { 0.5 * width };
-            let z = top[c] + half - rng.range(0.002, 0.008);
-            top[c] = z + half;
+            let z = *top + half - rng.range(0.002, 0.008);
+            *top = z + half;
             let theta = if upright {
                 std::f64::consts::FRAC_PI_2 + rng.range(-0.1, 0.1)
             } else {
@@ -80,7 +80,12 @@ fn by_pair(s: &Simulation) -> BTreeMap<(u32, u32), [f64; 7]> {
             (
                 (p.i, p.j),
                 [
-                    c.force[0], c.force[1], c.torque[0], c.torque[1], c.overlap, c.arm[0],
+                    c.force[0],
+                    c.force[1],
+                    c.torque[0],
+                    c.torque[1],
+                    c.overlap,
+                    c.arm[0],
                     c.arm[1],
                 ],
             )
@@ -101,7 +106,10 @@ fn assert_contacts_agree(test: &str, v: &Value, steps: u64, tol: f64, least: usi
     let keys = |m: &BTreeMap<(u32, u32), [f64; 7]>| m.keys().copied().collect::<Vec<_>>();
     assert_eq!(keys(&a), keys(&b), "{test}: the contact lists differ");
     let f_max = b.values().map(|c| c[0].hypot(c[1])).fold(0.0, f64::max);
-    let t_max = b.values().map(|c| c[2].abs().max(c[3].abs())).fold(0.0, f64::max);
+    let t_max = b
+        .values()
+        .map(|c| c[2].abs().max(c[3].abs()))
+        .fold(0.0, f64::max);
     let (mut df, mut dt, mut dd, mut dp) = (0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let d_max = b.values().map(|c| c[4].abs()).fold(0.0, f64::max);
     for (k, c) in &b {
@@ -116,10 +124,20 @@ fn assert_contacts_agree(test: &str, v: &Value, steps: u64, tol: f64, least: usi
          largest, overlaps {dd:.1e} of the deepest, points {dp:.1e} widths",
         b.len()
     );
-    assert!(b.len() >= least, "{test}: the scene is in contact ({})", b.len());
+    assert!(
+        b.len() >= least,
+        "{test}: the scene is in contact ({})",
+        b.len()
+    );
     assert!(df < tol, "{test}: forces differ by {df:.2e} of the largest");
-    assert!(dt < tol, "{test}: torques differ by {dt:.2e} of the largest");
-    assert!(dd < tol, "{test}: overlaps differ by {dd:.2e} of the deepest");
+    assert!(
+        dt < tol,
+        "{test}: torques differ by {dt:.2e} of the largest"
+    );
+    assert!(
+        dd < tol,
+        "{test}: overlaps differ by {dd:.2e} of the deepest"
+    );
     assert!(dp < tol, "{test}: contact points differ by {dp:.2e} widths");
 }
 
@@ -146,7 +164,11 @@ fn cohesive_rod_contacts_and_their_springs_match_the_cpu_over_rebuilds() {
     let mut g = GpuSimulation::with_gpu(common::sim(&v), gpu).unwrap();
     g.advance(400).unwrap();
     (0..400).for_each(|_| cpu.step().unwrap());
-    assert!(g.rebuilds() >= 5, "the lists were rebuilt ({})", g.rebuilds());
+    assert!(
+        g.rebuilds() >= 5,
+        "the lists were rebuilt ({})",
+        g.rebuilds()
+    );
     let gs = g.download().spring_table().sub;
     let cs = cpu.spring_table().sub;
     assert_eq!(
@@ -166,7 +188,10 @@ fn cohesive_rod_contacts_and_their_springs_match_the_cpu_over_rebuilds() {
             worst = worst.max((g.get(c.key[m]) - c.xi[m]).abs() / xi_max);
         }
     }
-    eprintln!("{test}: {} pairs' springs, worst {worst:.1e} of the largest", cs.len());
+    eprintln!(
+        "{test}: {} pairs' springs, worst {worst:.1e} of the largest",
+        cs.len()
+    );
     assert!(worst < 2e-3, "springs differ by {worst:.2e} of the largest");
 }
 
@@ -222,7 +247,12 @@ fn a_rod_deposition_agrees_with_the_cpu() {
     let com = |s: &Simulation| {
         let p = &s.particles;
         let m: f64 = p.mass.iter().sum();
-        [0, 1].map(|k| (0..p.len()).map(|i| p.mass[i] * p.position(i)[k]).sum::<f64>() / m)
+        [0, 1].map(|k| {
+            (0..p.len())
+                .map(|i| p.mass[i] * p.position(i)[k])
+                .sum::<f64>()
+                / m
+        })
     };
     let (ca, cb) = (com(gs), com(&cpu));
     eprintln!(
@@ -241,7 +271,10 @@ fn a_rod_deposition_agrees_with_the_cpu() {
     // Measured: 1.1e-5 widths (after the first impacts; 1e-6 before).
     assert!(worst < 1e-4, "positions differ by {worst:.2e} widths");
     assert!(cpu.contacts.len() > 12, "the rods lie in a deposit");
-    assert!((ca[0] - cb[0]).abs() < 0.5 && (ca[1] - cb[1]).abs() < 0.2, "centre of mass");
+    assert!(
+        (ca[0] - cb[0]).abs() < 0.5 && (ca[1] - cb[1]).abs() < 0.2,
+        "centre of mass"
+    );
     let (a, b) = (gs.contacts.len() as f64, cpu.contacts.len() as f64);
     assert!((a - b).abs() <= 0.2 * b, "contacts");
 }
@@ -264,7 +297,10 @@ fn gpu_rod_runs_resume_bitwise() {
     let path = dir.join("ckpt.bin");
     std::fs::write(&path, bytes).unwrap();
     let loaded = talus::checkpoint::read(&path, &[]).unwrap();
-    let ds = loaded.device.as_ref().expect("a GPU checkpoint carries the device state");
+    let ds = loaded
+        .device
+        .as_ref()
+        .expect("a GPU checkpoint carries the device state");
     assert!(
         ds.sub.iter().any(|s| s.key[0] != u32::MAX),
         "the checkpoint holds sub-contact springs"
@@ -273,6 +309,9 @@ fn gpu_rod_runs_resume_bitwise() {
     c.advance(steps - steps / 2).unwrap();
     let (sa, sc) = (a.device_state(), c.device_state());
     assert!(sa.states.len() == 16, "{} rods", sa.states.len());
-    assert!(sa == sc, "the resumed GPU run differs from the uninterrupted one");
+    assert!(
+        sa == sc,
+        "the resumed GPU run differs from the uninterrupted one"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

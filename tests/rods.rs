@@ -70,7 +70,9 @@ fn a_rod_on_its_flat_side_rests_on_two_points_carrying_half_its_weight_each() {
         true,
     );
     for path in PATHS {
-        let Some(s) = settle_on(path, &v, 3.0) else { continue };
+        let Some(s) = settle_on(path, &v, 3.0) else {
+            continue;
+        };
         let m = rod_mass();
         assert!((s.particles.mass[0] - m).abs() < 1e-6 * m);
         // Each end: k δ^{3/2} = m g / 2.
@@ -94,7 +96,9 @@ fn a_rod_on_its_tip_rests_on_one_point_carrying_its_whole_weight() {
         true,
     );
     for path in PATHS {
-        let Some(s) = settle_on(path, &v, 3.0) else { continue };
+        let Some(s) = settle_on(path, &v, 3.0) else {
+            continue;
+        };
         let delta = (rod_mass() * G / K_N).powf(2.0 / 3.0);
         let overlap = 1.5 - s.particles.q[0][0][1];
         assert!(
@@ -117,7 +121,9 @@ fn a_rod_on_another_loads_both_points_of_each_contact_equally() {
         true,
     );
     for path in PATHS {
-        let Some(s) = settle_on(path, &v, 3.0) else { continue };
+        let Some(s) = settle_on(path, &v, 3.0) else {
+            continue;
+        };
         let m = rod_mass();
         let (low, high) = (
             (m * G / K_N).powf(2.0 / 3.0),
@@ -126,7 +132,10 @@ fn a_rod_on_another_loads_both_points_of_each_contact_equally() {
         let tol = tolerance(path);
         let z = [s.particles.q[0][0][1], s.particles.q[0][1][1]];
         assert!((0.5 - z[0] - low).abs() < tol * low, "{path:?}: {z:?}");
-        assert!((z[0] + 1.0 - z[1] - high).abs() < tol * high, "{path:?}: {z:?}");
+        assert!(
+            (z[0] + 1.0 - z[1] - high).abs() < tol * high,
+            "{path:?}: {z:?}"
+        );
         assert!(
             s.particles.q[0][1][2].abs() < 1e-9,
             "{path:?}: no torque: the two points are equal"
@@ -168,7 +177,9 @@ fn cohesion_holds_a_rod_up_against_gravity_and_lets_it_go_when_weaker() {
     let bond = 1.0;
     let delta = ((bond - 0.5) * m * G / K_N).powf(2.0 / 3.0);
     for path in PATHS {
-        let Some(z) = hanging(path, bond) else { continue };
+        let Some(z) = hanging(path, bond) else {
+            continue;
+        };
         assert!(
             (z - (-1.0 + delta)).abs() < tolerance(path) * delta,
             "{path:?}: height {z} against {}",

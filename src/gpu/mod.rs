@@ -177,7 +177,8 @@ fn unsupported_spheropolygons(sim: &Simulation) -> Option<String> {
         return None;
     }
     let p = &sim.particles;
-    let mut wide = (0..p.len()).filter(|&i| p.shape[i].len() > 2 || (p.is_polygon(i) && !p.is_swept(i)));
+    let mut wide =
+        (0..p.len()).filter(|&i| p.shape[i].len() > 2 || (p.is_polygon(i) && !p.is_swept(i)));
     if let Some(i) = wide.next() {
         return Some(format!(
             "particle {i} is a spheropolygon with a core of {} corners; the GPU path takes \

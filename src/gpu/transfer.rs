@@ -663,7 +663,12 @@ pub(super) fn initial_state(
             if !table.sub.is_empty() {
                 // Every pair with sub-contact springs has an entry, its springs beside it.
                 let mut by_key: std::collections::BTreeMap<u64, (f64, SubSprings)> = (e.iter())
-                    .map(|x| ((x.i as u64) << 32 | x.j as u64, (x.value as f64, SubSprings::default())))
+                    .map(|x| {
+                        (
+                            (x.i as u64) << 32 | x.j as u64,
+                            (x.value as f64, SubSprings::default()),
+                        )
+                    })
                     .collect();
                 for (&k, sub) in &table.sub {
                     by_key.entry(k).or_insert((0.0, SubSprings::default())).1 = sub_to_device(sub);
