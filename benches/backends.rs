@@ -21,6 +21,7 @@ fn main() {
         &backends,
         &sizes,
         &polygon_sizes,
+        &[1000, 6000],
         200,
         None,
         true,

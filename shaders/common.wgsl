@@ -8,8 +8,6 @@
 const WG: u32 = 64u;
 // Workgroups of one dispatch in one dimension at most (src/gpu/mod.rs).
 const MAX_WORKGROUPS: u32 = 65535u;
-// Contacts per particle as the lower id (its own list) and as the higher id.
-const MAX_CONTACTS: u32 = 16u;
 const WALL_BASE: u32 = 0xFFFF0000u;
 const EMPTY: u32 = 0xFFFFFFFFu;
 // Params.law
@@ -108,6 +106,10 @@ struct Params {
     // 1: sort the particles in memory by cell at every rebuild (permute.wgsl); 0: keep
     // them where they are (tests: the results must not depend on it)
     reorder: u32,
+    // Candidates per particle as the lower id (its own list, slots i list_cap + k) and
+    // as the higher id (its down list): 16, more for long rods (src/gpu/mod.rs
+    // `list_capacity`)
+    list_cap: u32,
     // hertz_cohesive (paper 004 sec. 2): Bo g, the cohesive pull per unit of the
     // contact's mass scale, and the cohesion range d_c (length)
     bond_g: f32,
@@ -199,7 +201,7 @@ struct Candidate {
 // The bindings are declared after this file, generated from src/gpu/bindings.rs
 // BINDINGS: `read` where no entry point of the module writes the buffer.
 
-// Every candidate of the lists as one compact list of `count` slots (i MAX_CONTACTS +
+// Every candidate of the lists as one compact list of `count` slots (i list_cap +
 // k), written by find_contacts at a rebuild, for contact_forces under the overlap-area
 // law, which takes one thread per pair (issue 14 item 5). clear_cells empties it.
 struct PairList {

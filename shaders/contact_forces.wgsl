@@ -56,7 +56,7 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>,
         let total = atomicLoad(&pairs.count);
         for (var t = gid.x; t < total; t += groups.x * WG) {
             let slot = pairs.slot[t];
-            let i = slot / MAX_CONTACTS;
+            let i = slot / params.list_cap;
             if (SPHEROPOLYGONS) {
                 spheropolygon_force(i, slot, props[i].mass, velocity(i));
             } else {
@@ -72,7 +72,7 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>,
     let m1 = props[i].mass;
     let v1 = velocity(i);
     for (var k = 0u; k < contact_count[i]; k++) {
-        candidate_force(i, i * MAX_CONTACTS + k, ri, m1, v1);
+        candidate_force(i, i * params.list_cap + k, ri, m1, v1);
     }
 }
 

@@ -1,7 +1,7 @@
 // Stage (src/neighbours.rs `list_candidates`; at a rebuild of the lists only): for
 // particle i, every j of a higher id in the 3x3 cells around it whose circles come
 // within the skin of the law's range, sorted by id, then its walls. Each candidate is also entered
-// in j's `down` list (slot index i * MAX_CONTACTS + k), which the reduction needs; that
+// in j's `down` list (slot index i * list_cap + k), which the reduction needs; that
 // list is filled by atomics and sorted where it is read. Whether a candidate touches is
 // decided at every step, in contact_forces (`touches`, `touches_wall`).
 
@@ -36,8 +36,8 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= params.n_cap || !rebuilding()) { return; }
     if (i >= live() || halted() || !is_active(i)) { contact_count[i] = 0u; return; }
     mark_listed(i);
-    var found: array<u32, MAX_CONTACTS>;
-    var found_id: array<u32, MAX_CONTACTS>;
+    // The list is built in place, in i's `params.list_cap` slots of contact_j.
+    let base = i * params.list_cap;
     var n = 0u;
     let id_i = ids[i];
     let fixed_i = is_fixed(i);
@@ -47,8 +47,9 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let x0 = max(i32(c.x) - 1, 0);
     let x1 = min(c.x + 1u, params.nx - 1u);
     let hashed = hashed_grid();
-    for (var z = u32(z0); z <= z1; z++) {
-        for (var x = u32(x0); x <= x1; x++) {
+    var full = false;
+    for (var z = u32(z0); z <= z1 && !full; z++) {
+        for (var x = u32(x0); x <= x1 && !full; x++) {
             let cell = bucket(vec2<u32>(x, z));
             let start = cell_start[cell];
             let end = start + atomicLoad(&cell_count[cell]);
@@ -60,36 +61,33 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
                 // for each of them): only this cell's particles count here.
                 if (hashed && any(cell_coords(state[j].anchor) != vec2<u32>(x, z))) { continue; }
                 if (!is_candidate(i, j)) { continue; }
-                if (n == MAX_CONTACTS) { halt(HALT_CONTACTS_FULL, i); break; }
+                if (n == params.list_cap) { halt(HALT_CONTACTS_FULL, i); full = true; break; }
                 // Insertion sort by id: the order must not depend on the cell layout or
                 // on the memory order.
                 var k = n;
-                while (k > 0u && found_id[k - 1u] > id_j) {
-                    found[k] = found[k - 1u];
-                    found_id[k] = found_id[k - 1u];
+                while (k > 0u && ids[contact_j[base + k - 1u]] > id_j) {
+                    contact_j[base + k] = contact_j[base + k - 1u];
                     k--;
                 }
-                found[k] = j;
-                found_id[k] = id_j;
+                contact_j[base + k] = j;
                 n++;
             }
         }
     }
-    if (!fixed_i) {
+    if (!fixed_i && !full) {
         for (var w = 0u; w < params.n_walls; w++) {
             if (!is_wall_candidate(i, w)) { continue; }
-            if (n == MAX_CONTACTS) { halt(HALT_CONTACTS_FULL, i); break; }
-            found[n] = WALL_BASE + w;
+            if (n == params.list_cap) { halt(HALT_CONTACTS_FULL, i); break; }
+            contact_j[base + n] = WALL_BASE + w;
             n++;
         }
     }
     for (var k = 0u; k < n; k++) {
-        let j = found[k];
-        contact_j[i * MAX_CONTACTS + k] = j;
+        let j = contact_j[base + k];
         if (j < WALL_BASE) {
             let d = atomicAdd(&down_count[j], 1u);
-            if (d < MAX_CONTACTS) {
-                down[j * MAX_CONTACTS + d] = i * MAX_CONTACTS + k;
+            if (d < params.list_cap) {
+                down[j * params.list_cap + d] = base + k;
             } else {
                 halt(HALT_CONTACTS_FULL, j);
             }
@@ -100,7 +98,7 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     // per pair: the list of them (in no particular order; each pair's result goes to its
     // own slot).
     if ((POLYGONS || SPHEROPOLYGONS) && n > 0u) {
-        let base = atomicAdd(&pairs.count, n);
-        for (var k = 0u; k < n; k++) { pairs.slot[base + k] = i * MAX_CONTACTS + k; }
+        let first = atomicAdd(&pairs.count, n);
+        for (var k = 0u; k < n; k++) { pairs.slot[first + k] = base + k; }
     }
 }

@@ -25,13 +25,13 @@ fn find_entry(i: u32, j: u32) -> u32 {
 // (src/neighbours.rs `down_lists` builds them in that order; find_contacts appends them
 // in whatever order its threads arrive). Sorted in place, once per rebuild.
 fn sort_down_list(p: u32) {
-    let nd = min(atomicLoad(&down_count[p]), MAX_CONTACTS);
-    let base = p * MAX_CONTACTS;
+    let nd = min(atomicLoad(&down_count[p]), params.list_cap);
+    let base = p * params.list_cap;
     for (var a = 1u; a < nd; a++) {
         let s = down[base + a];
-        let key = ids[s / MAX_CONTACTS];
+        let key = ids[s / params.list_cap];
         var k = a;
-        while (k > 0u && ids[down[base + k - 1u] / MAX_CONTACTS] > key) {
+        while (k > 0u && ids[down[base + k - 1u] / params.list_cap] > key) {
             down[base + k] = down[base + k - 1u];
             k--;
         }
@@ -45,7 +45,7 @@ fn gather_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= live() || halted() || !rebuilding()) { return; }
     let swept = params.law == LAW_HERTZ;
     for (var k = 0u; k < contact_count[i]; k++) {
-        let slot = i * MAX_CONTACTS + k;
+        let slot = i * params.list_cap + k;
         let e = find_entry(ids[i], partner_key(contact_j[slot]));
         var value = 0.0;
         if (e != EMPTY) { value = table[e].value; }

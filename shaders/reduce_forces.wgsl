@@ -10,14 +10,14 @@
 fn kick_sum(p: u32) -> vec3<f32> {
     var acc = vec3<f32>(0.0);
     // The down list is in id order since the rebuild (gather_history.wgsl).
-    let nd = min(atomicLoad(&down_count[p]), MAX_CONTACTS);
+    let nd = min(atomicLoad(&down_count[p]), params.list_cap);
     for (var a = 0u; a < nd; a++) {
-        let ft = contact_ft[down[p * MAX_CONTACTS + a]];
+        let ft = contact_ft[down[p * params.list_cap + a]];
         acc -= vec3<f32>(ft.xy, 0.0);
         acc.z += ft.w;
     }
     for (var k = 0u; k < contact_count[p]; k++) {
-        let ft = contact_ft[p * MAX_CONTACTS + k];
+        let ft = contact_ft[p * params.list_cap + k];
         acc += ft.xyz;
     }
     return acc;

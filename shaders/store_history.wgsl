@@ -44,7 +44,7 @@ fn store_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (i >= live() || halted() || !storing()) { return; }
     let swept = params.law == LAW_HERTZ;
     for (var k = 0u; k < contact_count[i]; k++) {
-        let slot = i * MAX_CONTACTS + k;
+        let slot = i * params.list_cap + k;
         if (touching[slot] != 0u) {
             let e = insert(ids[i], partner_key(contact_j[slot]), hist_in[slot], i);
             // A spheropolygon pair's sub-contact springs go beside the entry.

@@ -120,6 +120,43 @@ pub fn polygon_pile_scene(n: usize) -> String {
     .to_string()
 }
 
+/// About `n` rods of aspect 5 and width 1 under paper 004's law, lying in rows on each
+/// other in a box 20 rods wide (a settled deposit: two sub-contacts per pair of
+/// neighbours in a column, leapfrog as in R9).
+pub fn rod_pile_scene(n: usize) -> String {
+    let cols = 20usize;
+    let rows = n.div_ceil(cols).max(1);
+    let pitch = 5.05;
+    let w = cols as f64 * pitch;
+    let list: Vec<serde_json::Value> = (0..rows * cols)
+        .map(|k| {
+            let (c, r) = ((k % cols) as f64, (k / cols) as f64);
+            // Each row 2·10⁻³ into the one below, about the load of a deep deposit.
+            json!({ "position": [(c + 0.5) * pitch - 0.5 * w, 0.498 + 0.998 * r],
+                    "diameter": 1.0 })
+        })
+        .collect();
+    let h = rows as f64 + 5.0;
+    json!({
+        "name": format!("rod-pile-{n}"),
+        "dt": 1.5e-4,
+        "integrator": "leapfrog",
+        "stop": { "time": 1e9 },
+        "gravity": { "g": [0.0, -10.0] },
+        "domain": { "x": [-0.5 * w - 5.0, 0.5 * w + 5.0], "z": [-5.0, h + 5.0] },
+        "materials": { "m": { "density": 1.0 } },
+        "contact": { "law": "hertz_cohesive", "k_n": 1.0e7, "k_t": 1.0e6, "gamma_n": 300.0,
+                     "gamma_t": 100.0, "mu": 0.5, "bond": 0.0, "d_c": 1.0e-4 },
+        "walls": [{ "from": [-0.5 * w, 0.0], "to": [0.5 * w, 0.0] },
+                  { "from": [-0.5 * w, 0.0], "to": [-0.5 * w, h] },
+                  { "from": [0.5 * w, 0.0], "to": [0.5 * w, h] }],
+        "particles": [{ "kind": "list", "material": "m", "rod": { "aspect": 5.0 },
+                        "particles": list }],
+        "output": { "checkpoint_every": 0 }
+    })
+    .to_string()
+}
+
 fn engine(sim: Simulation, backend: BackendChoice) -> Result<Engine, String> {
     match backend {
         BackendChoice::Gpu => GpuSimulation::new(sim)
@@ -247,6 +284,7 @@ pub fn run(
     backends: &[BackendChoice],
     sizes: &[usize],
     polygon_sizes: &[usize],
+    rod_sizes: &[usize],
     steps: u64,
     budget: Option<f64>,
     pour: bool,
@@ -284,6 +322,11 @@ pub fn run(
         polygon_sizes
             .iter()
             .map(|&n| (format!("polygon-pile-{n}"), polygon_pile_scene(n))),
+    );
+    workloads.extend(
+        rod_sizes
+            .iter()
+            .map(|&n| (format!("rod-pile-{n}"), rod_pile_scene(n))),
     );
     if pour {
         let text = include_str!("../scenes/r4_pour_reduced.json");

@@ -153,6 +153,9 @@ enum Command {
         /// Sizes (polygons) of the polygon-pile workloads (regular 12-gons).
         #[arg(long, value_delimiter = ',', default_values_t = [1000, 10000, 50000])]
         polygon_sizes: Vec<usize>,
+        /// Sizes (rods of aspect 5, paper 004's law) of the rod-pile workloads.
+        #[arg(long, value_delimiter = ',', default_values_t = [1000])]
+        rod_sizes: Vec<usize>,
         /// Steps timed per workload (after a warm-up of a tenth as many); with --budget,
         /// the most steps timed.
         #[arg(long)]
@@ -257,11 +260,19 @@ fn command(command: Command) -> ExitCode {
             backend,
             sizes,
             polygon_sizes,
+            rod_sizes,
             steps,
             budget,
             pour,
             out,
-        } => cmd_bench(&backend, &sizes, &polygon_sizes, steps, budget, pour, out),
+        } => cmd_bench(
+            &backend,
+            (&sizes, &polygon_sizes, &rod_sizes),
+            steps,
+            budget,
+            pour,
+            out,
+        ),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -804,8 +815,7 @@ const DEFAULT_BUDGET: f64 = 3.0;
 
 fn cmd_bench(
     backends: &[Backend],
-    sizes: &[usize],
-    polygon_sizes: &[usize],
+    (sizes, polygon_sizes, rod_sizes): (&[usize], &[usize], &[usize]),
     steps: Option<u64>,
     budget: Option<f64>,
     pour: bool,
@@ -827,6 +837,7 @@ fn cmd_bench(
         backends,
         sizes,
         polygon_sizes,
+        rod_sizes,
         steps,
         budget,
         pour,

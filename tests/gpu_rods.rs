@@ -149,6 +149,70 @@ fn rod_contacts_match_the_cpu() {
     assert_contacts_agree("rod_contacts_match_the_cpu", &v, 1, 1e-4, 45);
 }
 
+/// Rods of aspect 10 laid as bricks (each row shifted by half a rod), rows 2·10⁻³ into
+/// each other: a packing near 1, where each rod's circumscribed circle (10 widths
+/// across, plus the skin) meets ~60 others.
+fn brick_rods(rows: usize, cols: usize) -> Value {
+    let mut rng = Rng::new(7);
+    let len = 10.0;
+    let list: Vec<Value> = (0..rows * cols)
+        .map(|k| {
+            let (r, c) = ((k / cols) as f64, (k % cols) as f64);
+            let shift = if (k / cols) % 2 == 1 { 0.5 * len } else { 0.0 };
+            json!({ "position": [1.0 + (c + 0.5) * (len + 0.02) + shift, 0.498 + 0.998 * r],
+                    "theta": rng.range(-1e-4, 1e-4), "diameter": 1.0 })
+        })
+        .collect();
+    let w = cols as f64 * (len + 0.02) + 0.5 * len + 2.0;
+    let mut v = common::scene_value(
+        json!({ "law": "hertz_cohesive", "k_n": 1.0e7, "k_t": 1.0e6, "gamma_n": 300.0,
+                "gamma_t": 100.0, "mu": 0.5, "bond": 0.0, "d_c": 1.0e-4 }),
+        json!([{ "kind": "list", "material": "m", "rod": { "aspect": len }, "particles": list }]),
+    );
+    v["dt"] = json!(1e-4);
+    v["integrator"] = json!("leapfrog");
+    v["gravity"] = json!({ "g": [0.0, -10.0] });
+    v["domain"] = json!({ "x": [-5.0, w + 5.0], "z": [-5.0, rows as f64 + 10.0] });
+    v["walls"] = json!([{ "from": [0.0, 0.0], "to": [w, 0.0] }]);
+    v
+}
+
+#[test]
+fn long_rods_in_a_dense_packing_fit_the_gpu_lists() {
+    // The lists of rods of aspect 10 hold more than the 16 candidates of disks and
+    // polygons (`gpu::list_capacity`); their contacts still match the CPU path's.
+    let v = brick_rods(24, 8);
+    let cap = talus::gpu::list_capacity(&common::sim(&v));
+    assert!(cap >= 48, "list capacity {cap}");
+    let cpu = {
+        let mut s = common::sim(&v);
+        s.step().unwrap();
+        s
+    };
+    // The CPU's most candidates of one particle, as the lower id (walls too) and as the
+    // higher: what the GPU's lists must hold.
+    let mut per = std::collections::HashMap::new();
+    for p in &cpu.neighbours.pairs {
+        *per.entry((0, p.i)).or_insert(0u32) += 1;
+        if !p.is_wall() {
+            *per.entry((1, p.j)).or_insert(0u32) += 1;
+        }
+    }
+    let most = per.values().copied().max().unwrap_or(0);
+    eprintln!("aspect 10: up to {most} candidates of one rod, list capacity {cap}");
+    assert!(
+        most > 16 && most <= cap,
+        "{most} candidates against a capacity of {cap}"
+    );
+    assert_contacts_agree(
+        "long_rods_in_a_dense_packing_fit_the_gpu_lists",
+        &v,
+        1,
+        1e-4,
+        300,
+    );
+}
+
 #[test]
 fn cohesive_rod_contacts_and_their_springs_match_the_cpu_over_rebuilds() {
     // 400 steps with cohesion (Bo = 50): the lists are rebuilt several times, and the

@@ -63,7 +63,7 @@ impl Buffers {
     /// initial contents `c`.
     pub(super) fn new(dev: &wgpu::Device, params: &Params, cells: u64, c: &Initial) -> Self {
         let n = params.n_cap as u64;
-        let m = MAX_CONTACTS as u64;
+        let m = params.list_cap as u64;
 
         let storage = wgpu::BufferUsages::STORAGE
             | wgpu::BufferUsages::COPY_DST

@@ -4,7 +4,8 @@
 
 use bytemuck::{Pod, Zeroable};
 
-/// Contacts per particle as the lower id, and as the higher id (`MAX_CONTACTS`).
+/// Candidates per particle as the lower id, and as the higher id, of disks and polygons
+/// (`Params::list_cap`; more for long rods, `gpu::list_capacity`).
 pub const MAX_CONTACTS: u32 = 16;
 /// Candidates of one source looked at per step (`INSERT_WINDOW`); the CPU path uses the
 /// same cap so that both insert on the same steps.
@@ -100,6 +101,7 @@ pub struct Params {
     pub skin: f32,
     /// 1: sort the particles in memory by cell at every rebuild (permute.wgsl).
     pub reorder: u32,
+    pub list_cap: u32,
     pub bond_g: f32,
     pub d_c: f32,
 }
@@ -286,6 +288,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 inv_unit,
                 skin,
                 reorder,
+                list_cap,
                 bond_g,
                 d_c
             ]

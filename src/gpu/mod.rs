@@ -136,10 +136,17 @@ pub const MIN_BUFFER: u64 = 256;
 /// The largest buffers that grow with the particle count n, and their sizes in bytes:
 /// what an adapter's binding limit must hold (checked before a run).
 pub fn particle_buffers(n: u64) -> [(&'static str, u64); 3] {
+    particle_buffers_with(n, MAX_CONTACTS)
+}
+
+/// `particle_buffers` with `cap` candidates per particle (`list_capacity`); a
+/// spheropolygon scene's springs take 32 bytes a candidate more (`sub_hist`), counted in
+/// `resume_with_gpu`.
+pub fn particle_buffers_with(n: u64, cap: u32) -> [(&'static str, u64); 3] {
     let table_cap = table_capacity(n);
     [
         ("particle state", n * size_of::<State>() as u64),
-        ("contact", n * MAX_CONTACTS as u64 * 16),
+        ("contact", n * cap as u64 * 16),
         ("spring table", table_cap * size_of::<Entry>() as u64),
     ]
 }
@@ -166,6 +173,41 @@ pub fn max_particles(binding: u64) -> u64 {
         if fits(mid) { lo = mid } else { hi = mid }
     }
     lo
+}
+
+/// Candidates per particle the lists hold (`Params::list_cap`): `MAX_CONTACTS` (16)
+/// for disks and polygons, whose circumscribed circles hold few neighbours; for long
+/// rods, whose circles (d widths across) each meet ~d others, twice the number expected
+/// as the lower id in a packing of 0.9 plus 8, in steps of 16: the circles within range
+/// plus the skin, π (σ + skin)² · 0.9 / A_min, halved. (Rods of d = 5 with the default
+/// skin: 48; d = 10: 64.)
+pub fn list_capacity(sim: &Simulation) -> u32 {
+    if !matches!(sim.law, ContactLaw::HertzCohesive(_)) {
+        return MAX_CONTACTS;
+    }
+    let p = &sim.particles;
+    let widest = (crate::scene::max_diameter(&sim.scene)).max(2.0 * p.max_radius());
+    let reach = sim.law.range_factor() * widest + sim.skin();
+    // The smallest area, of the blocks still to create and of the particles there are.
+    let mut area = crate::scene::smallest_particle_area(&sim.scene);
+    for i in 0..p.len() {
+        let a = if p.is_swept(i) {
+            crate::spheropolygon::Spheropolygon {
+                core: p.shape[i].clone(),
+                radius: p.sweep[i],
+            }
+            .area()
+        } else {
+            std::f64::consts::PI * p.radius[i] * p.radius[i]
+        };
+        area = area.min(a);
+    }
+    if !(area > 0.0 && area.is_finite()) {
+        return MAX_CONTACTS;
+    }
+    let expected = 0.5 * std::f64::consts::PI * reach * reach * 0.9 / area;
+    let cap = (2.0 * expected + 8.0).min(1024.0) as u32;
+    cap.next_multiple_of(16).max(MAX_CONTACTS)
 }
 
 /// What the GPU path cannot take of a spheropolygon scene (law hertz_cohesive): cores
@@ -293,8 +335,13 @@ impl GpuSimulation {
             .into());
         }
 
-        for (what, bytes) in particle_buffers(n_cap as u64) {
+        let list_cap = params.list_cap;
+        for (what, bytes) in particle_buffers_with(n_cap as u64, list_cap) {
             gpu.check_buffer(what, bytes)?;
+        }
+        if matches!(sim.law, ContactLaw::HertzCohesive(_)) {
+            let sub = n_cap as u64 * list_cap as u64 * size_of::<SubSprings>() as u64;
+            gpu.check_buffer("sub-contact spring", sub)?;
         }
         gpu.check_buffer("cell", cells * 4)?;
         let walls = device_walls(&sim.walls, origin, cell_size);

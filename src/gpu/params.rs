@@ -111,6 +111,7 @@ pub(super) fn step_params(
         inv_unit: (1.0 / position::unit(cell_size)) as f32,
         skin: skin as f32,
         reorder: 1,
+        list_cap: super::list_capacity(sim),
         ..Default::default()
     };
     law_params(law, &mut params);

@@ -429,7 +429,7 @@ impl GpuSimulation {
         if flags & control::HALT_CONTACTS_FULL != 0 {
             return Divergence::TooManyContacts {
                 id,
-                max: MAX_CONTACTS,
+                max: self.params.list_cap,
             };
         }
         Divergence::SpringTableFull { id }

@@ -376,7 +376,7 @@ impl GpuSimulation {
             self.sim.sources[k] = source::advanced(&b.spec, &b.state, r.inserted);
         }
         // This step's contacts, in the CPU's order (by i, then j, ids; walls last).
-        let m = MAX_CONTACTS as usize;
+        let m = self.params.list_cap as usize;
         let ids: Vec<u32> = self.read_buffer(&self.buffers.ids, 0, live);
         let key = |j: u32| if j >= WALL_BASE { j } else { ids[j as usize] };
         let count: Vec<u32> = self.read_buffer(&self.buffers.contact_count, 0, live);

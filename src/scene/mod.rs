@@ -11,7 +11,10 @@ mod validate;
 
 pub use overrides::apply_override;
 pub use schema::*;
-pub use validate::{max_diameter, polygon_of, reach_bound_of, shortest_contact_time, validate};
+pub use validate::{
+    max_diameter, polygon_of, reach_bound_of, shortest_contact_time, smallest_particle_area,
+    validate,
+};
 
 /// Non-fatal remarks about a valid scene (e.g. dt above t_c/10).
 pub fn warnings(scene: &Scene) -> Vec<String> {

@@ -166,10 +166,19 @@ fn reach_bounds(c: &Creation) -> (f64, f64) {
     }
 }
 
-/// Area of the smallest particle of a block: a disk, or a polygon on an ellipse with
-/// axes (a, b), which is the affine image of a regular polygon: (a b / 4)(C/2) sin(2π/C).
+/// Area of the smallest particle of a block: a disk, a rod of width w and aspect d (a
+/// stadium, w² (d − 1 + π/4)), or a polygon on an ellipse with axes (a, b), which is the
+/// affine image of a regular polygon: (a b / 4)(C/2) sin(2π/C).
 fn smallest_area(c: &Creation) -> f64 {
     let (lo, _) = size_bounds(c);
+    let rod = match c {
+        Creation::List(l) => l.rod.as_ref(),
+        Creation::PointSource(s) => s.rod.as_ref(),
+        _ => None,
+    };
+    if let Some(r) = rod {
+        return lo * lo * ((r.aspect - 1.0).max(0.0) + 0.25 * std::f64::consts::PI);
+    }
     match polygon_of(c) {
         None => std::f64::consts::PI * 0.25 * lo * lo,
         Some(p) => {
@@ -177,6 +186,13 @@ fn smallest_area(c: &Creation) -> f64 {
             0.25 * lo * lo * 0.5 * n * (std::f64::consts::TAU / n).sin()
         }
     }
+}
+
+/// The area of the smallest particle the scene's blocks create (∞ without blocks).
+pub fn smallest_particle_area(scene: &Scene) -> f64 {
+    (scene.particles.iter())
+        .map(smallest_area)
+        .fold(f64::INFINITY, f64::min)
 }
 
 fn material_of(c: &Creation) -> &str {
