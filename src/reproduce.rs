@@ -282,6 +282,7 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
                     // a rod waits until the outlet is free within its circumscribed
                     // circle, which limits the feed (for d = 10, to ~20 a second).
                     x.overrides.extend([
+                        "name=r9_rods".to_string(),
                         "particles[0].count=6000".to_string(),
                         "particles[0].rate=60".to_string(),
                         "particles[0].velocity=[0,-50]".to_string(),
