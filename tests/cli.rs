@@ -52,6 +52,38 @@ fn unknown_key_is_named() {
 }
 
 #[test]
+fn duplicate_keys_and_arrays_for_objects_are_named() {
+    // serde_json keeps the last of two equal keys; a scene must not (issue 16).
+    let text = talus::scene::DEFAULT_SCENE.replacen('{', r#"{"dt": 5.0,"#, 1);
+    let p = tmp("dup").join("scene.json");
+    std::fs::write(&p, text).unwrap();
+    assert_rejected(&["check", p.to_str().unwrap()], &["dt", "twice"]);
+    // An array where an object belongs would be read as its fields in order.
+    let p = scene_file("array", |v| v["stop"] = serde_json::json!([4.0, 0.5]));
+    assert_rejected(
+        &["check", p.to_str().unwrap()],
+        &["stop", "expected an object"],
+    );
+    let p = scene_file("array2", |v| {
+        v["particles"][1]["velocity_spread"] = serde_json::json!(null);
+        v["materials"] = serde_json::json!([[1.0]]);
+    });
+    let (code, _, err) = talus(&["check", p.to_str().unwrap()]);
+    assert_eq!(code, 2, "{err}");
+}
+
+#[test]
+fn a_name_that_is_a_path_is_refused() {
+    // Without --out the name is the output folder: `..` or `/` would write anywhere.
+    for name in ["../../escape", "/tmp/escape", ".hidden", "a/b", ""] {
+        let set = format!("name={name}");
+        assert_rejected(&["check", "--set", &set], &["name", "plain name"]);
+    }
+    let (code, out, err) = talus(&["check", "--set", "name=heap-2.v1_x+y"]);
+    assert_eq!(code, 0, "{out}{err}");
+}
+
+#[test]
 fn wrong_type_is_named() {
     let p = scene_file("type", |v| v["dt"] = "small".into());
     assert_rejected(&["check", p.to_str().unwrap()], &["dt"]);

@@ -7,6 +7,7 @@
 
 mod overrides;
 mod schema;
+mod strict;
 mod validate;
 
 pub use overrides::apply_override;
@@ -57,8 +58,7 @@ pub fn load(path: &Path, overrides: &[String]) -> Result<Scene, SceneError> {
 
 /// Parses scene text (JSON), applies `path=value` overrides, and validates the result.
 pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
-    let mut value: serde_json::Value =
-        serde_json::from_str(text).map_err(|e| SceneError::Syntax(e.to_string()))?;
+    let mut value = strict::parse_value(text)?;
     for o in overrides {
         apply_override(&mut value, o)?;
     }
@@ -67,8 +67,16 @@ pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
     Ok(scene)
 }
 
-/// Strict typed parse of a JSON value; errors carry the key path.
+/// Strict typed parse of a JSON value; errors carry the key path. An array where the
+/// scene has an object is refused (`strict::objects_are_objects`).
 pub fn from_value(value: serde_json::Value) -> Result<Scene, SceneError> {
+    let scene = typed(&value)?;
+    let back = serde_json::to_value(&scene).expect("a scene always serialises");
+    strict::objects_are_objects(&value, &back, "")?;
+    Ok(scene)
+}
+
+fn typed(value: &serde_json::Value) -> Result<Scene, SceneError> {
     serde_path_to_error::deserialize(value.clone()).map_err(|e| {
         let path = e.path().to_string();
         let path = if path == "." {
@@ -76,7 +84,7 @@ pub fn from_value(value: serde_json::Value) -> Result<Scene, SceneError> {
         } else {
             path
         };
-        refine_tagged_error(&value, &path)
+        refine_tagged_error(value, &path)
             .unwrap_or_else(|| SceneError::invalid(path, reason(e.into_inner())))
     })
 }

@@ -357,6 +357,19 @@ fn polygons(scene: &Scene) -> Result<(), SceneError> {
 /// Checks every value; returns warnings that do not stop a run.
 pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
     let mut warnings = Vec::new();
+    // Without --out the name is the output folder (runs/<name>): a path in it would
+    // write anywhere (issue 16).
+    let n = &scene.name;
+    let plain = |c: char| c.is_alphanumeric() || "-_.+".contains(c);
+    if n.is_empty() || n.starts_with('.') || !n.chars().all(plain) {
+        return Err(SceneError::invalid(
+            "name",
+            format!(
+                "must be a plain name of letters, digits and - _ . + not starting with a dot \
+                 (it names the output folder runs/<name>), got {n:?}"
+            ),
+        ));
+    }
     finite_positive("dt", scene.dt)?;
     finite_positive("stop.time", scene.stop.time)?;
     finite_positive("stop.check_every", scene.stop.check_every)?;
