@@ -309,6 +309,20 @@ impl GpuSimulation {
         }
         let origin = grid.origin;
 
+        // Every particle the point sources will still insert is drawn now, on the host:
+        // check that they fit the adapter before drawing them (a count of 4·10⁹ would
+        // otherwise abort on allocation; issue 16).
+        let to_come: u64 = (point_sources.iter().zip(&sim.sources))
+            .map(|(s, st)| s.count.saturating_sub(st.inserted) as u64)
+            .sum();
+        gpu.check_buffer(
+            "source candidate",
+            to_come.saturating_mul(size_of::<Candidate>() as u64),
+        )?;
+        gpu.check_buffer(
+            "particle state",
+            (to_come + sim.particles.len() as u64).saturating_mul(size_of::<State>() as u64),
+        )?;
         let up = insert::upcoming(&sim, &layered_specs, origin, cell_size);
         let n_now = sim.particles.len() as u32;
         let n_cap = (n_now + up.candidates.len() as u32 + up.layered_count).max(1);
