@@ -245,7 +245,10 @@ pub fn read(json_path: &Path) -> Result<Snapshot, String> {
             other => return Err(format!("column {}: unknown dtype {other}", c.name)),
         };
         let start = c.offset as usize;
-        let end = start + size * c.count as usize;
+        let end = (c.count as usize)
+            .checked_mul(size)
+            .and_then(|n| n.checked_add(start))
+            .unwrap_or(usize::MAX);
         let raw = bytes.get(start..end).ok_or_else(|| {
             format!(
                 "column {}.{} runs past the end of {}",
@@ -269,5 +272,51 @@ pub fn read(json_path: &Path) -> Result<Snapshot, String> {
         };
         columns.insert(format!("{}.{}", c.table, c.name), col);
     }
-    Ok(Snapshot { meta, columns })
+    let snap = Snapshot { meta, columns };
+    check(&snap).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    Ok(snap)
+}
+
+/// What a reader relies on (issue 16: a damaged or edited snapshot is refused, not
+/// indexed out of bounds or drawn with NaN): each table's columns as long as its count,
+/// the corners as many as the particles' corner counts add up to, every number finite,
+/// and each contact between particles of the snapshot (or a wall).
+fn check(s: &Snapshot) -> Result<(), String> {
+    let m = &s.meta;
+    let len = |c: &Column| match c {
+        Column::F64(v) => v.len(),
+        Column::U32(v) => v.len(),
+        Column::U8(v) => v.len(),
+    };
+    let corners: u64 = (s.u32("particles.corners").unwrap_or(&[]).iter())
+        .map(|&c| c as u64)
+        .sum();
+    for (key, c) in &s.columns {
+        let table = key.split('.').next().unwrap_or("");
+        let want = match table {
+            "particles" => m.particles,
+            "contacts" => m.contacts,
+            "corners" => corners,
+            _ => continue,
+        };
+        if len(c) as u64 != want {
+            return Err(format!("column {key} holds {} values, not {want}", len(c)));
+        }
+        if let Column::F64(v) = c
+            && let Some(k) = v.iter().position(|x| !x.is_finite())
+        {
+            return Err(format!("column {key}: value {k} is {}", v[k]));
+        }
+    }
+    let ids: std::collections::HashSet<u32> = (s.u32("particles.id").unwrap_or(&[]).iter())
+        .copied()
+        .collect();
+    for key in ["contacts.i", "contacts.j"] {
+        for &id in s.u32(key).unwrap_or(&[]) {
+            if !ids.contains(&id) && id < m.wall_base {
+                return Err(format!("{key}: particle {id} is not in the snapshot"));
+            }
+        }
+    }
+    Ok(())
 }

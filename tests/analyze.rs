@@ -227,6 +227,91 @@ fn the_command_writes_its_tables_and_rejects_bad_input() {
     assert!(err.contains("--window"), "{err}");
 }
 
+#[test]
+fn damaged_snapshots_are_refused_by_analyze_and_render() {
+    // Issue 16: a snapshot whose data do not match its JSON, or hold NaN, is refused with
+    // a message (exit 2), neither indexed out of bounds nor drawn.
+    let s = settled_column();
+    let dir = tmp("damaged");
+    let json = talus::snapshot::write(&s, &dir, "snap").unwrap();
+    assert!(talus::snapshot::read(&json).is_ok());
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let bin = std::fs::read(dir.join("snap.bin")).unwrap();
+    let column = |name: &str| {
+        let c = (meta["columns"].as_array().unwrap().iter())
+            .find(|c| {
+                format!(
+                    "{}.{}",
+                    c["table"].as_str().unwrap(),
+                    c["name"].as_str().unwrap()
+                ) == name
+            })
+            .unwrap()
+            .clone();
+        c["offset"].as_u64().unwrap() as usize
+    };
+    let cases: Vec<(&str, serde_json::Value, Vec<u8>, &str)> = vec![
+        (
+            "nan",
+            meta.clone(),
+            {
+                let mut b = bin.clone();
+                let at = column("particles.x") + 8;
+                b[at..at + 8].copy_from_slice(&f64::NAN.to_le_bytes());
+                b
+            },
+            "particles.x",
+        ),
+        (
+            "truncated",
+            meta.clone(),
+            bin[..bin.len() / 2].to_vec(),
+            "past the end",
+        ),
+        (
+            "count",
+            {
+                let mut m = meta.clone();
+                m["particles"] = serde_json::json!(meta["particles"].as_u64().unwrap() + 1);
+                m
+            },
+            bin.clone(),
+            "holds",
+        ),
+        (
+            "contact",
+            meta.clone(),
+            {
+                let mut b = bin.clone();
+                let at = column("contacts.i");
+                b[at..at + 4].copy_from_slice(&123_456u32.to_le_bytes());
+                b
+            },
+            "not in the snapshot",
+        ),
+    ];
+    for (name, m, b, must) in cases {
+        let d = tmp(&format!("damaged-{name}"));
+        std::fs::write(d.join("snap.json"), m.to_string()).unwrap();
+        std::fs::write(d.join("snap.bin"), &b).unwrap();
+        let e = talus::snapshot::read(&d.join("snap.json")).err();
+        assert!(
+            e.as_deref().is_some_and(|e| e.contains(must)),
+            "{name}: {e:?}"
+        );
+        for cmd in ["analyze", "render"] {
+            let out = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+                .args([cmd, d.join("snap.json").to_str().unwrap()])
+                .output()
+                .unwrap();
+            let err = String::from_utf8_lossy(&out.stderr);
+            assert_ne!(out.status.code(), Some(0), "{cmd} {name}");
+            assert!(!err.contains("panicked"), "{cmd} {name}: {err}");
+        }
+    }
+}
+
 /// The numbers of the VTK DataArray called `name` (ASCII format).
 fn data_array(xml: &str, name: &str) -> Vec<f64> {
     let tag = format!("Name=\"{name}\"");
