@@ -55,6 +55,31 @@ pub enum RunError {
     },
 }
 
+/// Removes the snapshots (with their VTK files) and checkpoints in a run folder whose
+/// step is past `step`; returns how many files went.
+fn remove_later_outputs(out: &Path, step: u64) -> Result<usize, RunError> {
+    let mut removed = 0;
+    for (sub, prefix) in [("snapshots", "snap_"), ("checkpoints", "ckpt_")] {
+        let dir = out.join(sub);
+        let Ok(entries) = std::fs::read_dir(&dir) else {
+            continue;
+        };
+        for e in entries.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            // snap_0000001000.json, .bin, _grains.vtp, _contacts.vtp; ckpt_0000001000.bin
+            let later = (name.strip_prefix(prefix))
+                .and_then(|rest| rest.get(..10))
+                .and_then(|digits| digits.parse::<u64>().ok())
+                .is_some_and(|s| s > step);
+            if later {
+                std::fs::remove_file(e.path()).map_err(io(&e.path()))?;
+                removed += 1;
+            }
+        }
+    }
+    Ok(removed)
+}
+
 /// VTK files of the snapshot just written (`output.vtk`), and `snapshots.pvd` listing
 /// every one so far.
 fn write_vtk(json: &Path, entries: &mut Vec<(f64, String, String)>) -> Result<(), RunError> {
@@ -187,6 +212,18 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
     if summary_path.exists() {
         std::fs::remove_file(&summary_path).map_err(io(&summary_path))?;
     }
+    // Outputs an earlier run left here past this run's start belong to another run (a
+    // reused --out) or will be written again (a resume): they go, so that no stale
+    // snapshot or checkpoint sits beside this run's (issue 16).
+    let removed = remove_later_outputs(out, engine.step())?;
+    if removed > 0 && !opts.quiet {
+        eprintln!(
+            "talus: removed {removed} snapshot and checkpoint files of an earlier run in {} \
+             (past step {})",
+            out.display(),
+            engine.step()
+        );
+    }
     let scene = engine.host().scene.clone();
     let scene_path = out.join("scene.json");
     let text = serde_json::to_string_pretty(&scene).expect("a scene always serialises");
@@ -217,6 +254,21 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
     let mut log = String::from(
         "step,time,particles,contacts,kinetic_translational,kinetic_rotational,elastic,potential\n",
     );
+    // A resumed run continues the log of the run it resumes: its rows up to the start.
+    if start_step > 0
+        && let Ok(old) = std::fs::read_to_string(out.join("log.csv"))
+        && old.starts_with(log.as_str())
+    {
+        for line in old.lines().skip(1) {
+            match line.split(',').next().and_then(|s| s.parse::<u64>().ok()) {
+                Some(step) if step <= start_step => {
+                    log.push_str(line);
+                    log.push('\n');
+                }
+                _ => break,
+            }
+        }
+    }
     let mut checkpoints: Vec<PathBuf> = Vec::new();
     let mut settled = false;
     // The mean kinetic energy per particle when the relaxation began (`kinetic_drop`).

@@ -313,6 +313,67 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
         err.contains("contact.mu") && err.contains("only stop.*, output.* and skin"),
         "{err}"
     );
+    // Resumed into its own folder (after a crash, say), the run keeps its log up to the
+    // checkpoint and goes on from there; its later snapshots and checkpoints are written
+    // again.
+    let log_before = std::fs::read_to_string(first.join("log.csv")).unwrap();
+    let midway = first.join("checkpoints/ckpt_0000001000.bin");
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--resume",
+        midway.to_str().unwrap(),
+        "--out",
+        first.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let log_after = std::fs::read_to_string(first.join("log.csv")).unwrap();
+    assert_eq!(log_after, log_before, "a bitwise resume logs the same rows");
+}
+
+#[test]
+fn a_reused_output_folder_keeps_no_stale_snapshots_or_checkpoints() {
+    // Issue 16: a fresh run into a folder an earlier run wrote removes that run's
+    // snapshots and checkpoints, so "the newest checkpoint" is this run's.
+    let dir = tmp("reused").join("run");
+    let run = |time: &str, every: &str| {
+        let (code, _, err) = talus(&[
+            "run",
+            "-q",
+            "--out",
+            dir.to_str().unwrap(),
+            "--set",
+            "particles[1].count=10",
+            "--set",
+            &format!("stop.time={time}"),
+            "--set",
+            &format!("output.checkpoint_every={every}"),
+            "--set",
+            &format!("output.snapshot_every={every}"),
+        ]);
+        assert_eq!(code, 0, "{err}");
+    };
+    run("4", "1");
+    let count = |sub: &str| std::fs::read_dir(dir.join(sub)).unwrap().count();
+    assert!(count("checkpoints") >= 3 && count("snapshots") >= 10);
+    run("2", "2");
+    let names = |sub: &str| -> Vec<String> {
+        let mut v: Vec<String> = (std::fs::read_dir(dir.join(sub)).unwrap())
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(names("checkpoints"), ["ckpt_0000001000.bin"]);
+    assert_eq!(
+        names("snapshots"),
+        [
+            "snap_0000000000.bin",
+            "snap_0000000000.json",
+            "snap_0000001000.bin",
+            "snap_0000001000.json"
+        ]
+    );
 }
 
 #[test]
