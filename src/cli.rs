@@ -339,6 +339,14 @@ fn cmd_analyze(
     if let Some(g) = g.filter(|g| !(g.is_finite() && *g > 0.0)) {
         return Err(bad_input(format!("--g must be positive, not {g}")));
     }
+    // Windows are --window wide every --step (and rows every --row): a step far below
+    // them only multiplies the windows (issue 16: --step 1e-9 aborted on allocation).
+    if step < 1e-3 * window || row < 1e-3 * window {
+        return Err(bad_input(format!(
+            "--step ({step}) and --row ({row}) must be at least a thousandth of --window \
+             ({window}): windows that close only repeat each other"
+        )));
+    }
     let input = analyze::input::load(path, g).map_err(bad_input)?;
     let dir = out.unwrap_or_else(|| beside(path, "analysis"));
     let opt = analyze::Options {
@@ -821,6 +829,20 @@ fn cmd_bench(
     pour: bool,
     out: Option<PathBuf>,
 ) -> Result<(), Failure> {
+    // A workload is built in memory first: at most 2·10⁷ particles (issue 16: --sizes
+    // 3e8 aborted on allocation).
+    for (flag, list) in [
+        ("--sizes", sizes),
+        ("--polygon-sizes", polygon_sizes),
+        ("--rod-sizes", rod_sizes),
+    ] {
+        if let Some(n) = list.iter().find(|&&n| !(1..=20_000_000).contains(&n)) {
+            return Err(Failure {
+                code: 2,
+                message: format!("{flag}: {n} particles; each size must be 1 to 2·10⁷"),
+            });
+        }
+    }
     if let Some(b) = budget.filter(|b| !(*b > 0.0 && b.is_finite())) {
         return Err(Failure {
             code: 2,

@@ -225,6 +225,10 @@ fn the_command_writes_its_tables_and_rejects_bad_input() {
     let (code, err) = run(&["analyze", json.to_str().unwrap(), "--window=-3"]);
     assert_eq!(code, 2);
     assert!(err.contains("--window"), "{err}");
+    // Windows a billionth of a diameter apart would be billions of windows.
+    let (code, err) = run(&["analyze", json.to_str().unwrap(), "--step", "1e-9"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--step"), "{err}");
 }
 
 #[test]

@@ -73,6 +73,31 @@ fn duplicate_keys_and_arrays_for_objects_are_named() {
 }
 
 #[test]
+fn absurd_counts_are_refused_before_anything_is_allocated() {
+    // Issue 16: a count of 4·10⁹ aborted on allocation, a lattice of 200 000 hung.
+    assert_rejected(
+        &["check", "--set", "particles[1].count=4294967295"],
+        &["particles[1].count", "limits.max_particles"],
+    );
+    let r1 = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/r1_pile.json");
+    assert_rejected(
+        &["run", r1, "--set", "particles[0].bottom_row=200000"],
+        &["particles[0].bottom_row", "limits.max_particles"],
+    );
+    assert_rejected(&["bench", "--sizes", "0"], &["--sizes"]);
+    assert_rejected(&["bench", "--rod-sizes", "30000000"], &["--rod-sizes"]);
+    // Meant: the limit raised, the same count is taken (a source streams its particles).
+    let (code, _, err) = talus(&[
+        "check",
+        "--set",
+        "particles[1].count=40000000",
+        "--set",
+        "limits.max_particles=1e8",
+    ]);
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
 fn a_name_that_is_a_path_is_refused() {
     // Without --out the name is the output folder: `..` or `/` would write anywhere.
     for name in ["../../escape", "/tmp/escape", ".hidden", "a/b", ""] {

@@ -551,14 +551,23 @@ pub struct Limits {
     /// A run stops when an overlap exceeds this fraction of the smaller radius.
     #[serde(default = "default_max_overlap")]
     pub max_overlap: f64,
+    /// The most particles a scene may create (checked before anything is allocated;
+    /// about 1 kB of memory each): raise it for a larger scene on a larger machine.
+    #[serde(default = "default_max_particles")]
+    pub max_particles: f64,
 }
 
 impl Default for Limits {
     fn default() -> Self {
         Self {
             max_overlap: default_max_overlap(),
+            max_particles: default_max_particles(),
         }
     }
+}
+
+fn default_max_particles() -> f64 {
+    2e7
 }
 
 fn default_max_overlap() -> f64 {

@@ -188,6 +188,25 @@ fn smallest_area(c: &Creation) -> f64 {
     }
 }
 
+/// About how many particles a block creates, and the key that says so: computed from
+/// the block's numbers without creating anything.
+fn estimated_particles(c: &Creation) -> (f64, &'static str) {
+    match c {
+        Creation::LatticePile(p) => {
+            let l = p.bottom_row as f64;
+            (0.5 * l * (l + 1.0), "bottom_row")
+        }
+        Creation::Row(r) => (r.count as f64, "count"),
+        Creation::PointSource(s) => (s.count as f64, "count"),
+        Creation::List(l) => (l.particles.len() as f64, "particles"),
+        Creation::Layered(s) => {
+            let lo = size_bounds(c).0.max(f64::MIN_POSITIVE);
+            let rows = crate::create::layered::max_rows(s) as f64;
+            (rows * (s.base_width / lo + 1.0), "base_width")
+        }
+    }
+}
+
 /// The area of the smallest particle the scene's blocks create (∞ without blocks).
 pub fn smallest_particle_area(scene: &Scene) -> f64 {
     (scene.particles.iter())
@@ -396,6 +415,31 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
             "domain.z",
             "must be [min, max] with min < max",
         ));
+    }
+    // Counts before anything is allocated (issue 16: a `bottom_row` of 200 000 hung, a
+    // `count` of 4·10⁹ aborted on allocation).
+    let limit = scene.limits.max_particles;
+    if !(limit > 0.0) {
+        return Err(SceneError::invalid(
+            "limits.max_particles",
+            "must be a positive number",
+        ));
+    }
+    let mut total = 0.0;
+    for (k, c) in scene.particles.iter().enumerate() {
+        let (n, key) = estimated_particles(c);
+        total += n;
+        if total > limit {
+            return Err(SceneError::invalid(
+                format!("particles[{k}].{key}"),
+                format!(
+                    "the scene would create about {total:.3e} particles (~{:.0} GB), more \
+                     than limits.max_particles = {limit:.3e}; raise limits.max_particles \
+                     if you mean it",
+                    total * 1e3 / 1e9
+                ),
+            ));
+        }
     }
     if scene.materials.is_empty() {
         return Err(SceneError::invalid(
