@@ -11,7 +11,9 @@ use crate::springs::SpringTable;
 use crate::state::{GEAR_VALUES, Particles};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"TALUSCK2";
+const MAGIC: &[u8; 8] = b"TALUSCK3";
+/// Checkpoints before the checksum (stop 28): read as they are.
+const UNCHECKED_MAGIC: &[u8; 8] = b"TALUSCK2";
 /// Checkpoints of talus before polygons (no shapes): named in the error.
 const OLD_MAGIC: &[u8; 8] = b"TALUSCK1";
 /// Version of the raw device arrays a GPU checkpoint carries (fixed-point positions and,
@@ -28,6 +30,8 @@ pub enum CheckpointError {
         "{0} was written by an older talus (format TALUSCK1, before polygons); rerun the scene"
     )]
     OldFormat(String),
+    #[error("checkpoint {0} is damaged: its checksum does not match its contents")]
+    Checksum(String),
     #[error("checkpoint {0} is damaged: {1}")]
     Corrupt(String, crate::files::DecodeError),
     #[error("checkpoint {0} holds an invalid scene: {1}")]
@@ -114,7 +118,18 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
             e.bytes.extend_from_slice(raw);
         }
     }
+    // A checksum of everything before it (issue 16: of 30 random one-byte flips none was
+    // noticed and 9 resumed into another result).
+    let sum = checksum(&e.bytes);
+    e.bytes.extend_from_slice(&sum.to_le_bytes());
     e.bytes
+}
+
+/// FNV-1a (64 bits) over the bytes: any one-byte change alters it.
+fn checksum(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
 }
 
 /// The tag of the spheropolygon section at a checkpoint's end.
@@ -147,11 +162,19 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
     if bytes.len() >= 8 && &bytes[..8] == OLD_MAGIC {
         return Err(CheckpointError::OldFormat(name));
     }
-    if bytes.len() < 8 || &bytes[..8] != MAGIC {
+    let body = if bytes.len() >= 16 && &bytes[..8] == MAGIC {
+        let (body, sum) = bytes.split_at(bytes.len() - 8);
+        if checksum(body).to_le_bytes() != sum {
+            return Err(CheckpointError::Checksum(name));
+        }
+        body
+    } else if bytes.len() >= 8 && &bytes[..8] == UNCHECKED_MAGIC {
+        &bytes[..]
+    } else {
         return Err(CheckpointError::Magic(name));
-    }
+    };
     let corrupt = |e| CheckpointError::Corrupt(name.clone(), e);
-    let mut d = Decoder::new(&bytes[8..]);
+    let mut d = Decoder::new(&body[8..]);
     let scene_text = d.str().map_err(corrupt)?;
     for o in overrides {
         let key = o.split('=').next().unwrap_or("").trim();

@@ -184,5 +184,22 @@ fn damaged_checkpoint_is_an_error_not_a_panic() {
     assert!(err.to_string().contains("damaged"), "{err}");
     std::fs::write(&cut, b"not a checkpoint at all").unwrap();
     assert!(talus::checkpoint::read(&cut, &[]).is_err());
+    // Any one byte changed anywhere is noticed (the checksum), never resumed into another
+    // run: 200 random flips.
+    let mut rng = talus::rng::Rng::new(11);
+    for _ in 0..200 {
+        let mut b = bytes.clone();
+        let at = (rng.uniform() * b.len() as f64) as usize % b.len();
+        b[at] ^= 1 + (rng.uniform() * 255.0) as u8;
+        std::fs::write(&cut, &b).unwrap();
+        let err = talus::checkpoint::read(&cut, &[])
+            .err()
+            .unwrap_or_else(|| panic!("a flip at byte {at} of {} was not noticed", b.len()));
+        let text = err.to_string();
+        assert!(
+            text.contains("damaged") || text.contains("not a talus checkpoint"),
+            "{text}"
+        );
+    }
     std::fs::remove_dir_all(&tmp).ok();
 }
