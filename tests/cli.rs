@@ -430,6 +430,8 @@ fn bench_with_a_time_budget_reports_steps_and_microseconds() {
         "200",
         "--polygon-sizes",
         "30",
+        "--rod-sizes",
+        "40",
         "--pour",
         "false",
         "--budget",
@@ -445,7 +447,7 @@ fn bench_with_a_time_budget_reports_steps_and_microseconds() {
         serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
     assert_eq!(v, file, "the same report in --out");
     let results = v["results"].as_array().unwrap();
-    assert_eq!(results.len(), 2);
+    assert_eq!(results.len(), 3, "disks, polygons, rods");
     for r in results {
         let steps = r["steps"].as_u64().unwrap();
         let seconds = r["seconds"].as_f64().unwrap();
