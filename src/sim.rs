@@ -120,7 +120,8 @@ impl Simulation {
     /// Builds the initial state of a validated scene.
     pub fn new(scene: Scene) -> Result<Self, SceneError> {
         let mut rng = Rng::new(scene.seed);
-        let particles = create::initial_particles(&scene, &mut rng);
+        let (particles, starts) = create::initial_particles_by_block(&scene, &mut rng);
+        check_created(&scene, &particles, &starts)?;
         // Point sources first (the GPU path indexes them so), then layered blocks.
         let sources = (0..source_count(&scene))
             .map(|k| SourceState::new(scene.seed, k))
@@ -753,6 +754,70 @@ impl<'a> SurveyWatch<'a> {
         *lost_position = (lost != usize::MAX).then_some(lost);
         self.moved.into_inner()
     }
+}
+
+/// What the blocks created, checked before a run (issue 16): every particle inside the
+/// domain (one outside would be lost at once, silently), and every point source with a
+/// free spot at its outlet among the fixed particles (a source blocked by its own row
+/// would pour nothing).
+fn check_created(scene: &Scene, p: &Particles, starts: &[usize]) -> Result<(), SceneError> {
+    let d = &scene.domain;
+    for i in 0..p.len() {
+        let q = p.position(i);
+        if !(q[0] >= d.x[0] && q[0] <= d.x[1] && q[1] >= d.z[0] && q[1] <= d.z[1]) {
+            let k = starts.iter().rposition(|&s| s <= i).unwrap_or(0);
+            return Err(SceneError::invalid(
+                format!("particles[{k}]"),
+                format!(
+                    "creates particle {i} at ({:.6}, {:.6}), outside the domain x {:?}, z {:?}",
+                    q[0], q[1], d.x, d.z
+                ),
+            ));
+        }
+    }
+    for (k, c) in scene.particles.iter().enumerate() {
+        let crate::scene::Creation::PointSource(s) = c else {
+            continue;
+        };
+        // The outlet: x in [x0 − spread, x0 + spread] at z0, for a particle of the
+        // block's largest reach. Each fixed particle blocks an interval of x; the source
+        // can never pour if their union covers the outlet.
+        let r = 0.5
+            * crate::scene::reach_bound_of(s.diameter.as_ref(), s.polygon.as_ref())
+            * s.rod.as_ref().map_or(1.0, |rod| rod.aspect.max(1.0));
+        let (lo, hi) = (s.position[0] - s.spread, s.position[0] + s.spread);
+        let mut blocked: Vec<(f64, f64)> = (0..p.len())
+            .filter(|&j| p.fixed[j] && p.active[j])
+            .filter_map(|j| {
+                let q = p.position(j);
+                let reach = r + p.radius[j];
+                let dz = q[1] - s.position[1];
+                (dz.abs() < reach).then(|| {
+                    let w = (reach * reach - dz * dz).sqrt();
+                    (q[0] - w, q[0] + w)
+                })
+            })
+            .collect();
+        blocked.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut covered = lo;
+        for (a, b) in blocked {
+            if a > covered {
+                break;
+            }
+            covered = covered.max(b);
+        }
+        if covered > hi {
+            return Err(SceneError::invalid(
+                format!("particles[{k}].position"),
+                format!(
+                    "the source at ({}, {}) with spread {} is blocked everywhere by fixed \
+                     particles: it could never pour (move it up or widen its spread)",
+                    s.position[0], s.position[1], s.spread
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// Whether a position lies outside the domain [x0, x1] × [z0, z1] (a NaN does not).

@@ -98,6 +98,33 @@ fn absurd_counts_are_refused_before_anything_is_allocated() {
 }
 
 #[test]
+fn what_a_scene_creates_where_it_cannot_work_is_refused() {
+    // Issue 16: a wall beyond the domain was inert, particles created outside it were
+    // lost at once, a source blocked by its own row poured nothing; all exited 0.
+    assert_rejected(
+        &[
+            "check",
+            "--set",
+            r#"walls=[{"from": [0, 0], "to": [1e308, 0]}]"#,
+        ],
+        &["walls[0].to", "1e308", "outside the domain"],
+    );
+    let r1 = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/r1_pile_reduced.json");
+    assert_rejected(
+        &["check", r1, "--set", "domain.z=[-0.01,0.01]"],
+        &["particles[0]", "outside the domain"],
+    );
+    // The default scene's base row is fixed at z = 0: an outlet on it is blocked
+    // everywhere, one above it is not.
+    assert_rejected(
+        &["check", "--set", "particles[1].position=[0,0.5]"],
+        &["particles[1].position", "blocked everywhere"],
+    );
+    let (code, _, err) = talus(&["check", "--set", "particles[1].position=[0,1.6]"]);
+    assert_eq!(code, 0, "{err}");
+}
+
+#[test]
 fn a_name_that_is_a_path_is_refused() {
     // Without --out the name is the output folder: `..` or `/` would write anywhere.
     for name in ["../../escape", "/tmp/escape", ".hidden", "a/b", ""] {

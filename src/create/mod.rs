@@ -66,8 +66,15 @@ pub fn push(scene: &Scene, particles: &mut Particles, disk: &NewParticle) -> u32
 /// Creates every particle that exists at t = 0, in block order; draws from `rng` in a
 /// fixed order so the same seed gives the same particles.
 pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
+    initial_particles_by_block(scene, rng).0
+}
+
+/// `initial_particles`, and where each block's particles start (blocks in scene order).
+pub fn initial_particles_by_block(scene: &Scene, rng: &mut Rng) -> (Particles, Vec<usize>) {
     let mut particles = Particles::default();
+    let mut starts = Vec::new();
     for block in &scene.particles {
+        starts.push(particles.len());
         match block {
             Creation::LatticePile(p) => {
                 let material = material_index(scene, &p.material);
@@ -125,5 +132,5 @@ pub fn initial_particles(scene: &Scene, rng: &mut Rng) -> Particles {
             Creation::PointSource(_) | Creation::Layered(_) => {}
         }
     }
-    particles
+    (particles, starts)
 }

@@ -49,9 +49,16 @@ fn inside(scene: &Scene, path: &str, p: [f64; 2]) -> Result<(), SceneError> {
     if p[0] >= d.x[0] && p[0] <= d.x[1] && p[1] >= d.z[0] && p[1] <= d.z[1] {
         Ok(())
     } else {
+        let f = |v: f64| {
+            if v.abs() < 1e6 {
+                format!("{v}")
+            } else {
+                format!("{v:e}")
+            }
+        };
         Err(SceneError::invalid(
             path,
-            format!("({}, {}) lies outside the domain", p[0], p[1]),
+            format!("({}, {}) lies outside the domain", f(p[0]), f(p[1])),
         ))
     }
 }
@@ -458,6 +465,10 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 "a wall needs two distinct finite end points",
             ));
         }
+        // A wall beyond the domain touches nothing there (issue 16: one ending at 1e308
+        // was inert).
+        inside(scene, &format!("walls[{k}].from"), w.from)?;
+        inside(scene, &format!("walls[{k}].to"), w.to)?;
     }
     if scene.particles.is_empty() {
         return Err(SceneError::invalid(
