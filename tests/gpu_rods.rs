@@ -66,9 +66,10 @@ fn random_rods(rows: usize, cols: usize, bond: f64, seed: u64) -> Value {
     v["gravity"] = json!({ "g": [0.0, -10.0] });
     v["domain"] = json!({ "x": [-3.0, w + 3.0], "z": [-3.0, 3.0 + rows as f64 * 1.2 + 6.0] });
     v["limits"] = json!({ "max_overlap": 5.0 });
+    let h = rows as f64 * 1.2 + 6.0;
     v["walls"] = json!([{ "from": [0.0, 0.0], "to": [w, 0.0] },
-                        { "from": [0.0, 0.0], "to": [0.0, 20.0] },
-                        { "from": [w, 0.0], "to": [w, 20.0] }]);
+                        { "from": [0.0, 0.0], "to": [0.0, h] },
+                        { "from": [w, 0.0], "to": [w, h] }]);
     v
 }
 
