@@ -319,8 +319,18 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
     var m12 = m1;
     var mass = m1;
     var rmin = props[i].radius;
+    // Beyond the circumscribed circles (`radius` is a core's farthest corner plus its
+    // sweep) no sub-contact is in range: most candidates end here.
+    // (`circles_near` takes them with the law's range factor, whose margin holds d_c).
     if (wall) {
-        subs = wall_subs(i, j - WALL_BASE, gap);
+        let reach = (params.range_factor - 1.0 + 1.0e-5) * props[i].radius;
+        if (disk_wall(i, j - WALL_BASE).delta >= -reach) {
+            subs = wall_subs(i, j - WALL_BASE, gap);
+        } else {
+            subs.count = 0u;
+        }
+    } else if (!circles_near(i, j)) {
+        subs.count = 0u;
     } else {
         let o = offset_ij(i, j);
         // Centres more than 1.5 cells apart cannot touch (cores fit in a cell).

@@ -200,12 +200,18 @@ impl Spheropolygon {
     }
 }
 
+/// The edges of a core of n corners (no allocation: this runs for every pair and step).
+fn edge_iter(n: usize) -> impl Iterator<Item = (usize, usize)> {
+    let count = match n {
+        0 | 1 => 0,
+        2 => 1,
+        _ => n,
+    };
+    (0..count).map(move |k| (k, (k + 1) % n))
+}
+
 fn edges(n: usize) -> Vec<(usize, usize)> {
-    match n {
-        0 | 1 => Vec::new(),
-        2 => vec![(0, 1)],
-        _ => (0..n).map(|k| (k, (k + 1) % n)).collect(),
-    }
+    edge_iter(n).collect()
 }
 
 /// One contact point of a pair of spheropolygons, seen from particle i.
@@ -224,6 +230,10 @@ pub struct SubContact {
     pub arm: P2,
 }
 
+/// The sub-contacts of a pair, inline up to eight (a rod pair has at most four): no heap
+/// allocation per pair and step.
+pub type SubList = smallvec::SmallVec<[SubContact; 8]>;
+
 pub const VERTEX_I: u32 = 0;
 pub const VERTEX_J: u32 = 1 << 16;
 pub const VERTICES: u32 = 2 << 16;
@@ -240,15 +250,28 @@ pub fn sub_contacts(
     (q, rq): (&[P2], f64),
     d: P2,
     gap: f64,
-    out: &mut Vec<SubContact>,
+    out: &mut SubList,
 ) {
     out.clear();
     let reach = rp + rq + gap;
+    // Most candidates of a neighbour list do not touch: beyond their circumscribed
+    // circles about the centres (the cores' farthest corners plus the sweeps) no
+    // sub-contact can be in range.
+    let far = |c: &[P2]| {
+        c.iter()
+            .map(|v| v[0] * v[0] + v[1] * v[1])
+            .fold(0.0, f64::max)
+            .sqrt()
+    };
+    let circles = far(p) + far(q) + reach;
+    if d[0] * d[0] + d[1] * d[1] >= circles * circles {
+        return;
+    }
     // j's corners relative to i's centre.
-    let qi: Vec<P2> = q.iter().map(|c| sub(*c, d)).collect();
+    let qi: smallvec::SmallVec<[P2; 16]> = q.iter().map(|c| sub(*c, d)).collect();
     // Vertices of one side against the edges of the other; `flip`: the vertex is j's.
-    let pairs = |verts: &[P2], cores: &[P2], flip: bool, out: &mut Vec<SubContact>| {
-        for (a, e) in edges(cores.len()).into_iter().enumerate() {
+    let pairs = |verts: &[P2], cores: &[P2], flip: bool, out: &mut SubList| {
+        for (a, e) in edge_iter(cores.len()).enumerate() {
             let (ea, eb) = (cores[e.0], cores[e.1]);
             for (k, &v) in verts.iter().enumerate() {
                 let edge = sub(eb, ea);
@@ -316,7 +339,7 @@ pub fn sub_contacts(
 }
 
 /// The contact of two point cores (disks) at a and b, relative to i's centre.
-fn vertices(a: P2, b: P2, (rp, rq): (f64, f64), reach: f64, out: &mut Vec<SubContact>) {
+fn vertices(a: P2, b: P2, (rp, rq): (f64, f64), reach: f64, out: &mut SubList) {
     let gap = sub(a, b);
     let dist = norm(gap);
     if dist >= reach || dist.is_nan() {
@@ -381,7 +404,7 @@ pub struct PairForce {
     /// The updated springs of the sub-contacts in range.
     pub springs: SubSprings,
     /// Each sub-contact in range with its law's output (forces along n and t).
-    pub contacts: Vec<(SubContact, crate::law::ContactOutput)>,
+    pub contacts: smallvec::SmallVec<[(SubContact, crate::law::ContactOutput); 8]>,
 }
 
 /// The motion of one body: velocity (x, z) and angular velocity.
@@ -403,7 +426,7 @@ pub fn pair_force(
     springs: &SubSprings,
     dt: f64,
 ) -> PairForce {
-    let mut subs = Vec::new();
+    let mut subs = SubList::new();
     sub_contacts(p, q, d, law.d_c, &mut subs);
     // The deepest first: they keep their springs when there are more than MAX_SUB.
     subs.sort_by(|a, b| b.delta.total_cmp(&a.delta).then(a.key.cmp(&b.key)));
@@ -564,7 +587,7 @@ mod tests {
         let rod = Spheropolygon::rod(5.0, 1.0);
         // j lies under i, shifted by 1 along the rods, overlapping by 0.01.
         let d = [-1.0, 0.99];
-        let mut out = Vec::new();
+        let mut out = SubList::new();
         sub_contacts((&rod.core, 0.5), (&rod.core, 0.5), d, 0.0, &mut out);
         assert_eq!(out.len(), 2, "{out:?}");
         for c in &out {
@@ -585,7 +608,7 @@ mod tests {
     #[test]
     fn a_rods_end_on_anothers_side_touches_once_and_end_to_end_once() {
         let rod = Spheropolygon::rod(3.0, 1.0);
-        let mut out = Vec::new();
+        let mut out = SubList::new();
         // A T: j upright below i's middle, its top end 0.98 below i's axis.
         let upright = Spheropolygon {
             core: vec![[0.0, -1.0], [0.0, 1.0]],
@@ -682,7 +705,7 @@ mod tests {
             let brute = (ps.iter())
                 .flat_map(|a| qs.iter().map(move |b| norm(sub(*a, *b))))
                 .fold(f64::INFINITY, f64::min);
-            let mut out = Vec::new();
+            let mut out = SubList::new();
             sub_contacts((&s.core, s.radius), (&t.core, t.radius), d, 0.0, &mut out);
             let deepest = out
                 .iter()
@@ -701,7 +724,7 @@ mod tests {
                 assert!(out.is_empty(), "no contact at gap {}", -expected);
             }
             // Swapped: the same overlaps, normals and world points mirrored.
-            let mut swapped = Vec::new();
+            let mut swapped = SubList::new();
             sub_contacts(
                 (&t.core, t.radius),
                 (&s.core, s.radius),
