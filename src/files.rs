@@ -16,12 +16,32 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp: PathBuf = path.with_file_name(format!(".{name}.tmp"));
-    {
+    let written = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    // A failed write (a full disk, say) leaves no half-written temporary behind (issue 16).
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
     }
-    std::fs::rename(&tmp, path)
+    written
+}
+
+/// Removes the temporaries (`.NAME.tmp`) a killed process left in `dir`; returns how many.
+pub fn remove_stale_temporaries(dir: &Path) -> usize {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return 0;
+    };
+    entries
+        .flatten()
+        .filter(|e| {
+            let n = e.file_name().to_string_lossy().into_owned();
+            n.starts_with('.') && n.ends_with(".tmp") && e.path().is_file()
+        })
+        .filter(|e| std::fs::remove_file(e.path()).is_ok())
+        .count()
 }
 
 /// Little-endian binary encoding helpers shared by snapshots and checkpoints.
@@ -92,5 +112,25 @@ impl<'a> Decoder<'a> {
     }
     pub fn is_done(&self) -> bool {
         self.pos == self.bytes.len()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_failed_atomic_write_leaves_no_temporary() {
+        let dir = std::env::temp_dir().join(format!("talus-atomic-{}", std::process::id()));
+        // The target is a folder that is not empty: the rename fails.
+        let target = dir.join("target");
+        std::fs::create_dir_all(target.join("inside")).unwrap();
+        assert!(write_atomic(&target, b"data").is_err());
+        assert!(!dir.join(".target.tmp").exists(), "the temporary is gone");
+        // One left by a killed process is swept.
+        std::fs::write(dir.join(".snap.json.tmp"), b"half").unwrap();
+        assert_eq!(remove_stale_temporaries(&dir), 1);
+        assert!(!dir.join(".snap.json.tmp").exists());
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -215,11 +215,15 @@ pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunErro
     // Outputs an earlier run left here past this run's start belong to another run (a
     // reused --out) or will be written again (a resume): they go, so that no stale
     // snapshot or checkpoint sits beside this run's (issue 16).
-    let removed = remove_later_outputs(out, engine.step())?;
+    let removed = remove_later_outputs(out, engine.step())?
+        + ["", "snapshots", "checkpoints"]
+            .iter()
+            .map(|sub| crate::files::remove_stale_temporaries(&out.join(sub)))
+            .sum::<usize>();
     if removed > 0 && !opts.quiet {
         eprintln!(
-            "talus: removed {removed} snapshot and checkpoint files of an earlier run in {} \
-             (past step {})",
+            "talus: removed {removed} snapshot, checkpoint and temporary files of an earlier \
+             run in {} (past step {})",
             out.display(),
             engine.step()
         );
