@@ -51,6 +51,7 @@ const HALT_OVERLAP: u32 = 1u;
 const HALT_NOT_FINITE: u32 = 2u;
 const HALT_CONTACTS_FULL: u32 = 4u;
 const HALT_TABLE_FULL: u32 = 8u;
+const HALT_TOO_FAST: u32 = 16u;
 // Candidates of one source looked at per step.
 const INSERT_WINDOW: u32 = 4u;
 
@@ -114,6 +115,9 @@ struct Params {
     // contact's mass scale, and the cohesion range d_c (length)
     bond_g: f32,
     d_c: f32,
+    // limits.max_step_displacement, squared (0: no bound): the most a particle may move
+    // in one step, as a fraction of its radius (survey.wgsl `survey_one_at`)
+    max_step2: f32,
 };
 
 // Dynamic state: q[0] = (rem_x, rem_z, rem_theta, 0) with the position's remainder in

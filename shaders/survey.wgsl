@@ -24,8 +24,15 @@ fn survey_one(i: u32, bit: u32) {
     survey_one_at(i, bit, state[i]);
 }
 
-// `survey_one` for particle i at state s (the caller's copy, as it stores it).
+// `survey_one` for particle i at state s (the caller's copy, as it stores it); also
+// halts the run when its step q1 = v dt is longer than the bound (issue 16: a grain
+// faster than that tunnels through fixed rows; src/sim.rs `SurveyWatch::survey_one`).
 fn survey_one_at(i: u32, bit: u32, s: State) {
+    if (params.max_step2 > 0.0 && is_active(i)) {
+        let step = q1_total(s.q1_whole, s.q[1]).xy;
+        let r = props[i].radius;
+        if (dot(step, step) > params.max_step2 * r * r) { halt(HALT_TOO_FAST, i); }
+    }
     if (params.skin <= 0.0) {
         if (i == 0u) { atomicOr(&control[C_LISTS], bit); }
         return;

@@ -40,6 +40,10 @@ pub enum Divergence {
         ratio: f64,
         limit: f64,
     },
+    #[error(
+        "particle {id} moves by {ratio:.3} of its radius in one step (limits.max_step_displacement = {limit}): it would pass through its neighbours without meeting them; a smaller dt, or a softer start"
+    )]
+    TooFast { id: u32, ratio: f64, limit: f64 },
 }
 
 /// The shortest `Simulation::advance` that sorts the particles in memory: sorting and
@@ -96,6 +100,9 @@ pub struct Simulation {
     velocity: Vec<Dof>,
     /// The first active particle whose position at the evaluated state is not finite.
     lost_position: Option<usize>,
+    /// The first active particle that moves by more than `limits.max_step_displacement`
+    /// of its radius in the step about to be evaluated.
+    too_fast: Option<usize>,
     /// Whether a step has moved the springs into the neighbour list.
     committed: bool,
     /// Each memory slot's particle id. The identity, except inside `advance`, which
@@ -128,7 +135,7 @@ impl Simulation {
             .collect();
         let mut sim =
             Self::from_parts(scene, particles, SpringTable::default(), sources, rng, 0, 0)?;
-        sim.seed_accelerations();
+        sim.start()?;
         Ok(sim)
     }
 
@@ -181,6 +188,7 @@ impl Simulation {
             record_contacts: true,
             velocity: Vec::new(),
             lost_position: None,
+            too_fast: None,
             committed: false,
             ids: Vec::new(),
             reorder: false,
@@ -247,18 +255,18 @@ impl Simulation {
     /// read and write of the Gear values instead of two (bitwise the same as
     /// `gear::predict` followed by `survey`).
     fn survey_with(&mut self, predict: bool) -> bool {
-        let watch = SurveyWatch::new(&self.neighbours, &self.ids, &self.particles, self.scene.dt);
+        let watch = SurveyWatch::new(&self.neighbours, &self.ids, &self.particles, &self.scene);
         let p = &mut self.particles;
         self.velocity.resize(p.len(), [0.0; 3]);
-        let (q, active, fixed) = (&mut p.q, &p.active, &p.fixed);
+        let (q, active, fixed, radius) = (&mut p.q, &p.active, &p.fixed, &p.radius);
         crate::parallel::for_each6_with(q, &mut self.velocity, |i, v, velocity| {
             let [q0, q1, q2, q3, q4, q5] = v;
             if predict && active[i] && !fixed[i] {
                 gear::predict_in_place([&mut *q0, &mut *q1, q2, q3, q4, q5]);
             }
-            watch.survey_one(i, *q0, *q1, active[i], velocity);
+            watch.survey_one(i, *q0, *q1, active[i], radius[i], velocity);
         });
-        watch.finish(&mut self.lost_position)
+        watch.finish(&mut self.lost_position, &mut self.too_fast)
     }
 
     /// Gear's correction of this step, the boundaries, and the prediction and survey
@@ -271,10 +279,10 @@ impl Simulation {
         let (x, z) = (d.x, d.z);
         let escaped = AtomicUsize::new(0);
         let (list, kicks) = (&self.neighbours, &self.candidates.kicks);
-        let watch = SurveyWatch::new(list, &self.ids, &self.particles, dt);
+        let watch = SurveyWatch::new(list, &self.ids, &self.particles, &self.scene);
         let p = &mut self.particles;
-        let (q, active, fixed, mass, inertia) =
-            (&mut p.q, &mut p.active, &p.fixed, &p.mass, &p.inertia);
+        let (q, active, fixed, mass, inertia, radius) =
+            (&mut p.q, &mut p.active, &p.fixed, &p.mass, &p.inertia, &p.radius);
         crate::parallel::for_each6_with2(q, &mut self.velocity, active, |i, v, velocity, on| {
             let [q0, q1, q2, q3, q4, q5] = v;
             let integrated = *on && !fixed[i];
@@ -294,10 +302,10 @@ impl Simulation {
             if integrated && *on {
                 gear::predict_in_place([&mut *q0, &mut *q1, q2, q3, q4, q5]);
             }
-            watch.survey_one(i, *q0, *q1, *on, velocity);
+            watch.survey_one(i, *q0, *q1, *on, radius[i], velocity);
         });
         self.lost += escaped.into_inner() as u64;
-        watch.finish(&mut self.lost_position)
+        watch.finish(&mut self.lost_position, &mut self.too_fast)
     }
 
     /// Stages 2–8 at the current (predicted) state: the neighbour list (rebuilt when a
@@ -501,15 +509,62 @@ impl Simulation {
         self.neighbours.table(&in_contact, &self.ids)
     }
 
-    /// Starts Gear with the true initial acceleration in q2, (F/m + g) dt²/2 from the
-    /// contact forces of the initial configuration: free flight is exact from the first
-    /// step, and a packing created at rest in its equilibrium stays there instead of
-    /// starting with a kick of g dt²/2.
-    fn seed_accelerations(&mut self) {
-        if self.scene.integrator != IntegratorKind::Gear5 {
-            return;
-        }
+    /// The initial state's contacts: overlaps deeper than `limits.initial_overlap` are
+    /// bad input (issue 16: particles placed into each other diverged at step 0 as a run
+    /// failure); under Gear the forces also give q2 = a dt²/2, so that the first
+    /// prediction knows them. The lists built here are the ones the first step would
+    /// build (same positions): no result changes.
+    fn start(&mut self) -> Result<(), SceneError> {
         self.evaluate_contacts();
+        self.check_initial_overlaps()?;
+        if self.scene.integrator == IntegratorKind::Gear5 {
+            self.seed_accelerations();
+        }
+        self.pairs.clear();
+        self.contacts.clear();
+        Ok(())
+    }
+
+    /// The pairs of the contacts just evaluated that overlap by more than
+    /// `limits.initial_overlap` of the smaller radius, deepest first, as an error naming
+    /// them.
+    fn check_initial_overlaps(&self) -> Result<(), SceneError> {
+        let limit = self.scene.limits.initial_overlap;
+        let mut deep: Vec<(f64, Pair)> = (self.pairs.iter().zip(&self.contacts))
+            .map(|(&p, c)| (overlap_ratio(&self.particles, p, c), p))
+            .filter(|(ratio, _)| !(*ratio <= limit))
+            .collect();
+        if deep.is_empty() {
+            return Ok(());
+        }
+        deep.sort_by(|a, b| b.0.total_cmp(&a.0));
+        let name = |p: Pair| {
+            let ids = id_pair(p, &self.ids);
+            if p.is_wall() {
+                format!("particle {} and wall {}", ids.i, p.j - crate::contacts::WALL_BASE)
+            } else {
+                format!("particles {} and {}", ids.i, ids.j)
+            }
+        };
+        let listed: Vec<String> = (deep.iter().take(5))
+            .map(|&(ratio, p)| format!("{} by {ratio:.3}", name(p)))
+            .collect();
+        let more = match deep.len() {
+            n if n > listed.len() => format!(" ({n} pairs in all)"),
+            _ => String::new(),
+        };
+        Err(SceneError::invalid(
+            "limits.initial_overlap",
+            format!(
+                "the initial particles overlap deeper than {limit} of the smaller radius: \
+                 {}{more}; move them apart (or raise limits.initial_overlap if you mean it)",
+                listed.join(", ")
+            ),
+        ))
+    }
+
+    /// Gear's q2 from the forces of the contacts just evaluated and gravity.
+    fn seed_accelerations(&mut self) {
         reduce_candidate_forces(
             &self.particles,
             &self.neighbours,
@@ -530,8 +585,6 @@ impl Simulation {
                 h * f[2] / p.inertia[i],
             ];
         }
-        self.pairs.clear();
-        self.contacts.clear();
     }
 
     /// One time step: insert, predict, neighbour list, contacts and forces, springs,
@@ -669,7 +722,27 @@ impl Simulation {
                 what: "position",
             });
         }
+        if let Some(id) = self.too_fast {
+            return Err(self.too_fast_report(id as u32));
+        }
         Ok(())
+    }
+
+    /// The report of particle `id` moving too far in one step: by how much, from its
+    /// state now (q1 = v dt).
+    pub fn too_fast_report(&self, id: u32) -> Divergence {
+        let p = &self.particles;
+        // Inside an advance the particles may be in cell order; outside, slot = id.
+        let slot = match self.ids.iter().position(|&k| k == id) {
+            Some(i) => Some(i),
+            None => (self.ids.is_empty() && (id as usize) < p.len()).then_some(id as usize),
+        };
+        let ratio = slot.map_or(f64::NAN, |i| p.q[1][i][0].hypot(p.q[1][i][1]) / p.radius[i]);
+        Divergence::TooFast {
+            id,
+            ratio,
+            limit: self.scene.limits.max_step_displacement,
+        }
     }
 
     /// Boundary stage: particles whose centre left the domain are removed.
@@ -710,34 +783,44 @@ impl Simulation {
 }
 
 /// What the survey of the particles watches for (`Simulation::survey_with`): motion
-/// beyond the skin of the neighbour list and positions that are not finite.
+/// beyond the skin of the neighbour list, positions that are not finite, and particles
+/// moving too far in one step.
 struct SurveyWatch<'a> {
     list: &'a NeighbourList,
     ids: &'a [u32],
     dt: f64,
     /// Whether the list is not stale anyway (then each particle's motion is checked).
     check_moves: bool,
+    /// (limits.max_step_displacement)², or infinity when the guard is off.
+    max_step2: f64,
     moved: AtomicBool,
     /// The smallest id of an active particle whose position is not finite.
     lost: AtomicUsize,
+    /// The smallest id of an active particle moving too far in one step.
+    fast: AtomicUsize,
 }
 
 impl<'a> SurveyWatch<'a> {
-    fn new(list: &'a NeighbourList, ids: &'a [u32], particles: &Particles, dt: f64) -> Self {
+    fn new(list: &'a NeighbourList, ids: &'a [u32], particles: &Particles, scene: &Scene) -> Self {
+        let f = scene.limits.max_step_displacement;
         SurveyWatch {
             list,
             ids,
-            dt,
+            dt: scene.dt,
             check_moves: !list.stale(particles),
+            max_step2: if f > 0.0 { f * f } else { f64::INFINITY },
             moved: AtomicBool::new(false),
             lost: AtomicUsize::new(usize::MAX),
+            fast: AtomicUsize::new(usize::MAX),
         }
     }
 
-    /// Particle i at the state about to be evaluated: its velocity q1/dt (what every
-    /// contact reads), whether it has moved beyond the skin, whether it is lost.
+    /// Particle i (of radius r) at the state about to be evaluated: its velocity q1/dt
+    /// (what every contact reads), whether it has moved beyond the skin, whether it is
+    /// lost, whether this step's displacement q1 = v dt exceeds the bound (issue 16:
+    /// a grain faster than that tunnels through fixed rows with no contact seen).
     #[inline(always)]
-    fn survey_one(&self, i: usize, q0: Dof, q1: Dof, active: bool, velocity: &mut Dof) {
+    fn survey_one(&self, i: usize, q0: Dof, q1: Dof, active: bool, r: f64, velocity: &mut Dof) {
         let dt = self.dt;
         *velocity = [q1[0] / dt, q1[1] / dt, q1[2] / dt];
         if self.check_moves && self.list.moved_to(i, q0, active) {
@@ -746,12 +829,18 @@ impl<'a> SurveyWatch<'a> {
         if active && !q0.iter().all(|v| v.is_finite()) {
             self.lost.fetch_min(self.ids[i] as usize, Ordering::Relaxed);
         }
+        if active && q1[0] * q1[0] + q1[1] * q1[1] > self.max_step2 * r * r {
+            self.fast.fetch_min(self.ids[i] as usize, Ordering::Relaxed);
+        }
     }
 
-    /// Notes the first lost position; returns whether a particle moved beyond the skin.
-    fn finish(self, lost_position: &mut Option<usize>) -> bool {
+    /// Notes the first lost position and the first particle too fast; returns whether
+    /// a particle moved beyond the skin.
+    fn finish(self, lost_position: &mut Option<usize>, too_fast: &mut Option<usize>) -> bool {
         let lost = self.lost.into_inner();
         *lost_position = (lost != usize::MAX).then_some(lost);
+        let fast = self.fast.into_inner();
+        *too_fast = (fast != usize::MAX).then_some(fast);
         self.moved.into_inner()
     }
 }

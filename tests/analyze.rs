@@ -851,6 +851,8 @@ fn the_slopes_of_a_synthetic_heap_are_recovered() {
     let law = json!({ "law": "spring_dashpot", "k_n": 1e5, "gamma_n": 10.0, "k_t": 2e4, "gamma_t": 1.0, "mu": 0.5 });
     let mut v = scene_value(law, json!([disks(&centres)]));
     v["domain"] = json!({ "x": [-200.0, 200.0], "z": [-10.0, 100.0] });
+    // The surface layer sits where it must for the slopes, into the lattice below.
+    v["limits"] = json!({ "initial_overlap": 1e9 });
     let s = sim(&v);
     let a = analyse(&s, &tmp("synthetic-heap"), 1.0);
     let sm = &a.summary;

@@ -45,7 +45,10 @@ fn random_scene(n: usize, law: serde_json::Value, seed: u64) -> serde_json::Valu
     v["gravity"] = json!({ "g": [0.0, -1.0] });
     v["domain"] = json!({ "x": [-3.0, w + 3.0], "z": [-3.0, w + 3.0] });
     // Random placement gives deep overlaps; the divergence check must not halt the kernels.
-    v["limits"] = json!({ "max_overlap": if polygons { 10.0 } else { 0.9 } });
+    v["limits"] = json!({
+        "max_overlap": if polygons { 10.0 } else { 0.9 },
+        "initial_overlap": 1e9
+    });
     v["walls"] = json!([{ "from": [0.0, 0.0], "to": [w, 0.0] }, { "from": [0.0, 0.0], "to": [0.0, w] },
                         { "from": [w, 0.0], "to": [w, w] }]);
     v
@@ -753,7 +756,7 @@ fn deep_polygon_overlaps_with_many_crossings_agree_with_the_cpu() {
     blocks.push(json!({ "kind": "list", "material": "m", "particles": disks }));
     let mut v = common::scene_value(polygons(), json!(blocks));
     v["domain"] = json!({ "x": [-3.0, 3.0 * n as f64 + 5.0], "z": [-2.0, 11.0] });
-    v["limits"] = json!({ "max_overlap": 1e9 });
+    v["limits"] = json!({ "max_overlap": 1e9, "initial_overlap": 1e300 });
     let Some(gpu) = common::gpu("deep_polygon_overlaps") else {
         return;
     };

@@ -165,6 +165,7 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("HALT_NOT_FINITE", c::HALT_NOT_FINITE as f64),
         ("HALT_CONTACTS_FULL", c::HALT_CONTACTS_FULL as f64),
         ("HALT_TABLE_FULL", c::HALT_TABLE_FULL as f64),
+        ("HALT_TOO_FAST", c::HALT_TOO_FAST as f64),
         ("MAX_WORKGROUPS", talus::gpu::MAX_WORKGROUPS as f64),
         ("HASH_X", talus::gpu::HASH_X as f64),
         ("HASH_Z", talus::gpu::HASH_Z as f64),

@@ -183,6 +183,8 @@ fn swapping_the_two_polygons_gives_equal_and_opposite_forces() {
     let run = |list: Vec<serde_json::Value>| {
         let mut v = polygon_scene(area_law(1e4, 0.3, 0.5), list, 7);
         v["dt"] = json!(1e-4);
+        // A deep overlap on purpose: the forces of a generic configuration.
+        v["limits"] = json!({ "initial_overlap": 1e9 });
         let mut s = sim(&v);
         s.step().unwrap();
         assert_eq!(s.pairs.len(), 1, "the two heptagons overlap");

@@ -50,6 +50,7 @@ pub mod control {
     pub const HALT_NOT_FINITE: u32 = 2;
     pub const HALT_CONTACTS_FULL: u32 = 4;
     pub const HALT_TABLE_FULL: u32 = 8;
+    pub const HALT_TOO_FAST: u32 = 16;
 }
 
 #[repr(C)]
@@ -104,6 +105,8 @@ pub struct Params {
     pub list_cap: u32,
     pub bond_g: f32,
     pub d_c: f32,
+    /// `limits.max_step_displacement`² (0: no bound).
+    pub max_step2: f32,
 }
 
 /// Dynamic state of one particle: q[0] = (rem_x, rem_z, rem_θ, 0) and the scaled Gear
@@ -290,7 +293,8 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 reorder,
                 list_cap,
                 bond_g,
-                d_c
+                d_c,
+                max_step2
             ]
         ),
         fields!(

@@ -426,6 +426,9 @@ impl GpuSimulation {
                 what: "force or position",
             };
         }
+        if flags & control::HALT_TOO_FAST != 0 {
+            return self.sim.too_fast_report(id);
+        }
         if flags & control::HALT_CONTACTS_FULL != 0 {
             return Divergence::TooManyContacts {
                 id,

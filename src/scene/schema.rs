@@ -555,6 +555,16 @@ pub struct Limits {
     /// about 1 kB of memory each): raise it for a larger scene on a larger machine.
     #[serde(default = "default_max_particles")]
     pub max_particles: f64,
+    /// The deepest overlap the initial particles may have, as a fraction of the smaller
+    /// radius: deeper is bad input (particles placed into each other), not a run to
+    /// start (issue 16).
+    #[serde(default = "default_initial_overlap")]
+    pub initial_overlap: f64,
+    /// A run stops when a particle moves by more than this fraction of its radius in one
+    /// step (it would pass through thin neighbours and fixed rows without meeting them:
+    /// tunnelling); 0 switches the guard off.
+    #[serde(default = "default_max_step_displacement")]
+    pub max_step_displacement: f64,
 }
 
 impl Default for Limits {
@@ -562,12 +572,22 @@ impl Default for Limits {
         Self {
             max_overlap: default_max_overlap(),
             max_particles: default_max_particles(),
+            initial_overlap: default_initial_overlap(),
+            max_step_displacement: default_max_step_displacement(),
         }
     }
 }
 
 fn default_max_particles() -> f64 {
     2e7
+}
+
+fn default_max_step_displacement() -> f64 {
+    0.5
+}
+
+fn default_initial_overlap() -> f64 {
+    0.05
 }
 
 fn default_max_overlap() -> f64 {

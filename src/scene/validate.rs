@@ -589,6 +589,11 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
     }
     finite_non_negative("output.log_every", o.log_every)?;
     finite_positive("limits.max_overlap", scene.limits.max_overlap)?;
+    finite_non_negative("limits.initial_overlap", scene.limits.initial_overlap)?;
+    finite_non_negative(
+        "limits.max_step_displacement",
+        scene.limits.max_step_displacement,
+    )?;
     if let Some(skin) = scene.skin {
         finite_non_negative("skin", skin)?;
     }
