@@ -532,7 +532,7 @@ impl Simulation {
         let limit = self.scene.limits.initial_overlap;
         let mut deep: Vec<(f64, Pair)> = (self.pairs.iter().zip(&self.contacts))
             .map(|(&p, c)| (overlap_ratio(&self.particles, p, c), p))
-            .filter(|(ratio, _)| !(*ratio <= limit))
+            .filter(|(ratio, _)| ratio.is_nan() || *ratio > limit)
             .collect();
         if deep.is_empty() {
             return Ok(());

@@ -126,3 +126,16 @@ fn a_particle_faster_than_the_bound_stops_the_run_on_both_paths() {
         );
     }
 }
+
+#[test]
+fn a_source_whose_outlet_reaches_beyond_the_domain_is_named() {
+    let mut v = disks(json!([]));
+    v["particles"] = json!([{
+        "kind": "point_source", "material": "m", "position": [90.0, 50.0],
+        "spread": 20.0, "rate": 10.0, "count": 10, "diameter": 1.0
+    }]);
+    let e = build(&v, &[]).err().expect("an outlet reaching x = 110 is refused");
+    assert!(e.contains("particles[0].spread") && e.contains("(110, 50)"), "{e}");
+    v["particles"][0]["spread"] = json!(5.0);
+    assert!(build(&v, &[]).is_ok());
+}

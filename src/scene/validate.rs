@@ -525,6 +525,11 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
             Creation::PointSource(s) => {
                 inside(scene, &at("position"), s.position)?;
                 finite_non_negative(&at("spread"), s.spread)?;
+                // The outlet's whole width: a particle drawn beyond the domain would be
+                // lost as it appears.
+                for side in [-1.0, 1.0] {
+                    inside(scene, &at("spread"), [s.position[0] + side * s.spread, s.position[1]])?;
+                }
                 finite_positive(&at("rate"), s.rate)?;
                 finite_non_negative(&at("start_time"), s.start_time)?;
                 drawn_sizes(&at, s.diameter.as_ref(), s.polygon.as_ref())?;
