@@ -69,6 +69,21 @@ pub struct Failure {
     pub error: String,
 }
 
+/// Why a workload could not be built or measured.
+#[derive(Debug, thiserror::Error)]
+pub enum BenchError {
+    /// A built-in workload's scene is invalid: a bug in this file.
+    #[error("{workload}: {source}")]
+    Scene {
+        workload: String,
+        source: scene::SceneError,
+    },
+    #[error(transparent)]
+    Gpu(#[from] crate::gpu::GpuError),
+    #[error(transparent)]
+    Diverged(#[from] crate::sim::Divergence),
+}
+
 /// A triangular packing of `n` unit disks, about twice as wide as high, on a floor.
 pub fn packing_scene(n: usize) -> String {
     let cols = ((2.0 * n as f64).sqrt().ceil() as usize).max(2);
@@ -157,13 +172,11 @@ pub fn rod_pile_scene(n: usize) -> String {
     .to_string()
 }
 
-fn engine(sim: Simulation, backend: BackendChoice) -> Result<Engine, String> {
-    match backend {
-        BackendChoice::Gpu => GpuSimulation::new(sim)
-            .map(|g| Engine::Gpu(Box::new(g)))
-            .map_err(|e| e.to_string()),
-        _ => Ok(Engine::cpu(sim)),
-    }
+fn engine(sim: Simulation, backend: BackendChoice) -> Result<Engine, BenchError> {
+    Ok(match backend {
+        BackendChoice::Gpu => Engine::Gpu(Box::new(GpuSimulation::new(sim)?)),
+        _ => Engine::cpu(sim),
+    })
 }
 
 fn gpu_counters(e: &Engine) -> Option<crate::gpu::Counters> {
@@ -182,11 +195,10 @@ fn measure(
     backend: BackendChoice,
     steps: u64,
     budget: Option<f64>,
-) -> Result<Measurement, String> {
+) -> Result<Measurement, BenchError> {
     let mut e = engine(sim, backend)?;
     let warm = if budget.is_some() { 10 } else { steps / 10 };
-    e.advance(warm.clamp(1, steps.max(1)))
-        .map_err(|d| d.to_string())?;
+    e.advance(warm.clamp(1, steps.max(1)))?;
     let n0 = e.active_count();
     let counters0 = gpu_counters(&e);
     let rebuilds0 = match &e {
@@ -196,14 +208,14 @@ fn measure(
     let t = Instant::now();
     let steps = match budget {
         None => {
-            e.advance(steps).map_err(|d| d.to_string())?;
+            e.advance(steps)?;
             steps
         }
         Some(budget) => {
             let (mut done, mut batch) = (0, 8u64);
             while done < steps {
                 let k = batch.min(steps - done);
-                e.advance(k).map_err(|d| d.to_string())?;
+                e.advance(k)?;
                 done += k;
                 if t.elapsed().as_secs_f64() >= budget {
                     break;
@@ -289,7 +301,7 @@ pub fn run(
     budget: Option<f64>,
     pour: bool,
     log: &mut dyn FnMut(String),
-) -> Result<Report, String> {
+) -> Result<Report, BenchError> {
     let mut results = Vec::new();
     let mut failures = Vec::new();
     // `auto`: the GPU path on a hardware adapter; a software one (lavapipe) only when
@@ -338,9 +350,13 @@ pub fn run(
         workloads.push(("r4-pour-reduced-wide".into(), wide.to_string()));
     }
     for (name, text) in &workloads {
-        let scene = scene::parse(text, &[]).map_err(|e| format!("{name}: {e}"))?;
+        let invalid = |source| BenchError::Scene {
+            workload: name.clone(),
+            source,
+        };
+        let scene = scene::parse(text, &[]).map_err(invalid)?;
         for &b in &backends {
-            let sim = Simulation::new(scene.clone()).map_err(|e| e.to_string())?;
+            let sim = Simulation::new(scene.clone()).map_err(invalid)?;
             // The pour starts nearly empty: time ten times longer to see it fill.
             let k = if name.starts_with("r4") {
                 10 * steps
@@ -355,7 +371,7 @@ pub fn run(
                     failures.push(Failure {
                         workload: name.clone(),
                         backend,
-                        error,
+                        error: error.to_string(),
                     });
                     continue;
                 }

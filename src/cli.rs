@@ -1,5 +1,6 @@
 //! Command line: clap turns arguments into a validated scene and options; errors are
-//! printed once here. Exit codes: 0 success, 1 failed run (divergence, I/O), 2 bad input.
+//! printed once here. Exit codes (`failure`): 0 success, 1 failed run (divergence,
+//! I/O), 2 bad input, 130 an interrupted run.
 
 use clap::{Parser, Subcommand};
 
@@ -11,8 +12,14 @@ macro_rules! out {
         let _ = writeln!(std::io::stdout(), $($t)*);
     }};
 }
+#[path = "cli/failure.rs"]
+mod failure;
+
+use failure::Failure;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 use talus::gpu::GpuSimulation;
 use talus::gpu::device::{self, BackendChoice as Backend};
 use talus::run::Engine;
@@ -46,8 +53,13 @@ enum Command {
         #[arg(long = "set", value_name = "PATH=VALUE")]
         overrides: Vec<String>,
         /// Continue from a checkpoint file (only stop.*, output.* and skin may be --set).
+        /// One of the output folder's own continues that run there.
         #[arg(long, conflicts_with = "scene")]
         resume: Option<PathBuf>,
+        /// Clear another run's outputs from the output folder first (otherwise such a
+        /// folder is refused).
+        #[arg(long)]
+        force: bool,
         #[arg(long, value_enum, default_value_t = Backend::Auto)]
         backend: Backend,
         /// No progress output.
@@ -174,26 +186,12 @@ enum Command {
     },
 }
 
-/// A failed command: its exit code and the message printed once by `main`.
-struct Failure {
-    code: u8,
-    message: String,
-}
-
-/// Bad input: exit code 2.
-fn bad_input(message: impl ToString) -> Failure {
-    Failure {
-        code: 2,
-        message: message.to_string(),
-    }
-}
-
 pub fn main() -> ExitCode {
     let cli = Cli::parse();
     let threads = match cli.threads {
         Some(0) => {
             eprintln!("error: --threads: must be at least 1, got 0");
-            return ExitCode::from(2);
+            return ExitCode::from(failure::INPUT);
         }
         Some(n) => n,
         None => std::thread::available_parallelism().map_or(1, |n| n.get()),
@@ -204,7 +202,7 @@ pub fn main() -> ExitCode {
         Ok(p) => p,
         Err(e) => {
             eprintln!("error: --threads {threads}: {e}");
-            return ExitCode::from(1);
+            return ExitCode::from(failure::FAILED);
         }
     };
     pool.install(|| command(cli.command))
@@ -217,9 +215,10 @@ fn command(command: Command) -> ExitCode {
             out,
             overrides,
             resume,
+            force,
             backend,
             quiet,
-        } => cmd_run(scene, out, overrides, resume, backend, quiet),
+        } => cmd_run(scene, out, overrides, resume, force, backend, quiet),
         Command::Check { scene, overrides } => cmd_check(scene, overrides),
         Command::DefaultScene => {
             out!("{}", scene::DEFAULT_SCENE.trim_end());
@@ -293,11 +292,12 @@ fn build_simulation(path: &Option<PathBuf>, overrides: &[String]) -> Result<Simu
     let name = path
         .as_ref()
         .map_or("default scene".to_string(), |p| p.display().to_string());
-    let scene = loaded.map_err(|e| bad_input(format!("in {name}: {e}")))?;
+    let within = |e| Failure::from(e).within(format!("in {name}"));
+    let scene = loaded.map_err(within)?;
     for w in scene::warnings(&scene) {
         eprintln!("warning: {w}");
     }
-    Simulation::new(scene).map_err(|e| bad_input(format!("in {name}: {e}")))
+    Simulation::new(scene).map_err(within)
 }
 
 /// Where results of a run folder or snapshot go by default: `NAME/` in the run folder,
@@ -324,30 +324,30 @@ fn cmd_analyze(
 ) -> Result<(), Failure> {
     use talus::analyze;
     if !(0.0 <= fit[0] && fit[0] < fit[1] && fit[1] <= 1.0) {
-        return Err(bad_input(format!(
+        return Err(Failure::input(format!(
             "--fit {} {}: needs 0 <= FROM < TO <= 1 (fractions of the heap's height)",
             fit[0], fit[1]
         )));
     }
     for (name, v) in [("--window", window), ("--step", step), ("--row", row)] {
         if !(v.is_finite() && v > 0.0) {
-            return Err(bad_input(format!(
+            return Err(Failure::input(format!(
                 "{name} must be a positive number of diameters, not {v}"
             )));
         }
     }
     if let Some(g) = g.filter(|g| !(g.is_finite() && *g > 0.0)) {
-        return Err(bad_input(format!("--g must be positive, not {g}")));
+        return Err(Failure::input(format!("--g must be positive, not {g}")));
     }
     // Windows are --window wide every --step (and rows every --row): a step far below
     // them only multiplies the windows (issue 16: --step 1e-9 aborted on allocation).
     if step < 1e-3 * window || row < 1e-3 * window {
-        return Err(bad_input(format!(
+        return Err(Failure::input(format!(
             "--step ({step}) and --row ({row}) must be at least a thousandth of --window \
              ({window}): windows that close only repeat each other"
         )));
     }
-    let input = analyze::input::load(path, g).map_err(bad_input)?;
+    let input = analyze::input::load(path, g)?;
     let dir = out.unwrap_or_else(|| beside(path, "analysis"));
     let opt = analyze::Options {
         window,
@@ -360,18 +360,18 @@ fn cmd_analyze(
     let mut earlier = Vec::new();
     if let Some(t) = from {
         if !path.is_dir() {
-            return Err(bad_input(
+            return Err(Failure::input(
                 "--from needs a run folder (it averages the run's snapshots)",
             ));
         }
-        for p in analyze::input::snapshots_from(path, t).map_err(bad_input)? {
-            let e = analyze::input::load(&p, g).map_err(bad_input)?;
+        for p in analyze::input::snapshots_from(path, t)? {
+            let e = analyze::input::load(&p, g)?;
             if e.step < input.step {
                 earlier.push(e);
             }
         }
     }
-    let a = analyze::analyze_series(input, earlier, &opt).map_err(bad_input)?;
+    let a = analyze::analyze_series(input, earlier, &opt)?;
     if a.summary.averaged_snapshots > 1 {
         out!(
             "stresses averaged over {} snapshots from t = {}",
@@ -379,10 +379,7 @@ fn cmd_analyze(
             a.summary.averaged_from_time
         );
     }
-    let files = analyze::write(&a, &dir).map_err(|e| Failure {
-        code: 1,
-        message: e,
-    })?;
+    let files = analyze::write(&a, &dir)?;
     let s = &a.summary;
     let o = &s.outline;
     out!(
@@ -424,28 +421,24 @@ fn cmd_render(
     g: Option<f64>,
 ) -> Result<(), Failure> {
     if !(16..=20_000).contains(&width) {
-        return Err(bad_input(format!(
+        return Err(Failure::input(format!(
             "--width must be between 16 and 20000 pixels, not {width}"
         )));
     }
     if !(window.is_finite() && window > 0.0) {
-        return Err(bad_input(format!(
+        return Err(Failure::input(format!(
             "--window must be a positive number of diameters, not {window}"
         )));
     }
     let dir = out.unwrap_or_else(|| beside(path, "pictures"));
-    let input = talus::analyze::input::load(path, g).map_err(bad_input)?;
+    let input = talus::analyze::input::load(path, g)?;
     let opt = talus::analyze::Options {
         window,
         ..Default::default()
     };
-    let a = talus::analyze::analyze(input, &opt).map_err(bad_input)?;
-    let fail = |e: String| Failure {
-        code: 1,
-        message: e,
-    };
-    let mut files = talus::render::render(&a, &dir, color, width).map_err(fail)?;
-    files.extend(talus::render::vtk::write(&a, &dir).map_err(fail)?);
+    let a = talus::analyze::analyze(input, &opt)?;
+    let mut files = talus::render::render(&a, &dir, color, width)?;
+    files.extend(talus::render::vtk::write(&a, &dir)?);
     out!("wrote {} files to {}", files.len(), dir.display());
     Ok(())
 }
@@ -471,24 +464,31 @@ fn cmd_reproduce(
 ) -> Result<(), Failure> {
     use talus::reproduce;
     let id = id.to_uppercase();
-    let mut variants = reproduce::variants(&id, full).map_err(bad_input)?;
+    let mut variants = reproduce::variants(&id, full)?;
     if let Some(only) = only {
         let names: Vec<String> = variants.iter().map(|v| v.name.clone()).collect();
         variants.retain(|v| v.name.contains(only));
         if variants.is_empty() {
-            return Err(bad_input(format!(
+            return Err(Failure::input(format!(
                 "--only {only}: no variant of {id} matches; they are {}",
                 names.join(", ")
             )));
         }
     }
     let root = out.unwrap_or_else(|| PathBuf::from("runs/reproduce").join(&id));
+    let interrupt = on_interrupt();
     let mut found = Vec::new();
     let mut failed = Vec::new();
     for v in &variants {
-        let scene = scene::parse(v.scene, &v.overrides)
-            .map_err(|e| bad_input(format!("{id} {}: {e}", v.name)))?;
-        let sim = Simulation::new(scene).map_err(|e| bad_input(format!("{id} {}: {e}", v.name)))?;
+        if interrupt.load(Ordering::Relaxed) {
+            return Err(Failure::interrupted(format!(
+                "{id}: interrupted before {}",
+                v.name
+            )));
+        }
+        let within = |e| Failure::from(e).within(format!("{id} {}", v.name));
+        let scene = scene::parse(v.scene, &v.overrides).map_err(within)?;
+        let sim = Simulation::new(scene).map_err(within)?;
         let dir = root.join(&v.name);
         let finished = reuse && finished_run_of(&dir, &sim.scene);
         if !quiet {
@@ -511,8 +511,16 @@ fn cmd_reproduce(
             &run::RunOptions {
                 out: dir.clone(),
                 quiet,
+                // A variant's folder is this reproduction's own: run again, it replaces
+                // the run there (--reuse keeps a finished one instead).
+                force: true,
+                resumed_from: None,
+                interrupt: interrupt.clone(),
             },
         ) {
+            if let run::RunError::Interrupted { .. } = e {
+                return Err(Failure::from(e).within(format!("{id} {}", v.name)));
+            }
             // A variant that fails is reported and the others still run.
             eprintln!("error: {id} {}: {e}", v.name);
             failed.push(serde_json::json!({ "variant": v.name, "error": e.to_string() }));
@@ -523,21 +531,16 @@ fn cmd_reproduce(
             row: v.row,
             ..Default::default()
         };
-        let fail = |e: String| Failure {
-            code: 1,
-            message: e,
-        };
-        let input = talus::analyze::input::load(&dir, None).map_err(fail)?;
-        let a = talus::analyze::analyze(input, &opt).map_err(fail)?;
-        talus::analyze::write(&a, &dir.join("analysis")).map_err(fail)?;
+        let input = talus::analyze::input::load(&dir, None)?;
+        let a = talus::analyze::analyze(input, &opt)?;
+        talus::analyze::write(&a, &dir.join("analysis"))?;
         talus::render::render(
             &a,
             &dir.join("pictures"),
             talus::render::Field::Pressure,
             1600,
-        )
-        .map_err(fail)?;
-        talus::render::vtk::write(&a, &dir.join("pictures")).map_err(fail)?;
+        )?;
+        talus::render::vtk::write(&a, &dir.join("pictures"))?;
         let f = reproduce::findings(&v.name, &a);
         out!(
             "{id} {}: {} grains, t = {:.3}; repose {:.1}° / {:.1}°; S_xx/S_zz (row 1, interior) {:.3}; S_zz under the apex / max: base {:.3} / {:.3} (dip {:.2}), row 1 {:.3} / {:.3} (dip {:.2}); Z interior {:.2}",
@@ -592,11 +595,7 @@ fn cmd_reproduce(
             &path,
             &format!("{id}: vertical stress in row 1"),
             &profiles,
-        )
-        .map_err(|e| Failure {
-            code: 1,
-            message: e,
-        })?;
+        )?;
     }
     for a in &averages {
         out!(
@@ -642,24 +641,18 @@ fn cmd_reproduce(
         &path,
         serde_json::to_string_pretty(&report).unwrap().as_bytes(),
     )
-    .map_err(|e| Failure {
-        code: 1,
-        message: format!("{}: {e}", path.display()),
-    })?;
+    .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
     out!(
         "{id}: {}; results in {}",
         reproduce::claim(&id),
         root.display()
     );
     if !failed.is_empty() {
-        return Err(Failure {
-            code: 1,
-            message: format!(
-                "{id}: {} of {} variants failed (listed in reproduce.json)",
-                failed.len(),
-                variants.len()
-            ),
-        });
+        return Err(Failure::failed(format!(
+            "{id}: {} of {} variants failed (listed in reproduce.json)",
+            failed.len(),
+            variants.len()
+        )));
     }
     Ok(())
 }
@@ -682,11 +675,12 @@ fn cmd_run(
     out: Option<PathBuf>,
     overrides: Vec<String>,
     resume: Option<PathBuf>,
+    force: bool,
     backend: Backend,
     quiet: bool,
 ) -> Result<(), Failure> {
     let start = match &resume {
-        Some(ckpt) => checkpoint::read(ckpt, &overrides).map_err(bad_input)?,
+        Some(ckpt) => checkpoint::read(ckpt, &overrides)?,
         None => checkpoint::Checkpoint::fresh(build_simulation(&path, &overrides)?),
     };
     let sim = &start.sim;
@@ -701,21 +695,23 @@ fn cmd_run(
             out.display()
         );
     }
+    // Before the engine is made (a GPU takes a while): `run::run` would refuse it too.
+    run::folder::refuse_another_run(&out, resume.as_deref(), force)?;
     let mut engine = choose_engine(start, backend, quiet)?;
     if !quiet {
         eprintln!("backend: {}", engine.name());
     }
+    let interrupt = on_interrupt();
     let s = run::run(
         &mut engine,
         &run::RunOptions {
             out: out.clone(),
             quiet,
+            force,
+            resumed_from: resume,
+            interrupt: interrupt.clone(),
         },
-    )
-    .map_err(|e| Failure {
-        code: 1,
-        message: e.to_string(),
-    })?;
+    )?;
     if !quiet {
         eprintln!(
             "done: {} steps to t = {:.4} ({}), {} particles ({} lost), {:.3e} particle-steps/s; results in {}",
@@ -727,6 +723,13 @@ fn cmd_run(
             s.particle_steps_per_second,
             out.display()
         );
+    }
+    if interrupt.load(Ordering::Relaxed) {
+        return Err(Failure::interrupted(format!(
+            "interrupted after the run finished: its final state was not analysed \
+             (`talus analyze {}` does it)",
+            out.display()
+        )));
     }
     // The final state's measurements and pictures; a failure here does not undo the run.
     match measure_and_draw(
@@ -744,9 +747,31 @@ fn cmd_run(
             out.display()
         ),
         Ok(_) => {}
-        Err(e) => eprintln!("warning: the final state could not be analysed: {e}"),
+        Err(e) => eprintln!(
+            "warning: the final state could not be analysed: {}",
+            e.message
+        ),
     }
     Ok(())
+}
+
+/// A flag that SIGINT and SIGTERM set: the run stops between two advances, removes its
+/// temporaries and says where its last checkpoint is. A second signal ends the process
+/// at once.
+fn on_interrupt() -> Arc<AtomicBool> {
+    use signal_hook::consts::{SIGINT, SIGTERM};
+    let flag = Arc::new(AtomicBool::new(false));
+    for signal in [SIGINT, SIGTERM] {
+        // The shutdown is registered first: it acts when the flag is already set.
+        let code = failure::INTERRUPTED.into();
+        let registered =
+            signal_hook::flag::register_conditional_shutdown(signal, code, flag.clone())
+                .and_then(|_| signal_hook::flag::register(signal, flag.clone()));
+        if let Err(e) = registered {
+            eprintln!("warning: signal {signal} will end the run without cleaning up: {e}");
+        }
+    }
+    flag
 }
 
 /// `talus analyze` and `talus render` on a snapshot or run folder: tables into
@@ -759,7 +784,7 @@ fn measure_and_draw(
     g: Option<f64>,
     field: talus::render::Field,
     width: u32,
-) -> Result<usize, String> {
+) -> Result<usize, Failure> {
     let input = talus::analyze::input::load(path, g)?;
     let a = talus::analyze::analyze(input, opt)?;
     let mut n = talus::analyze::write(&a, analysis)?.len();
@@ -778,15 +803,9 @@ fn choose_engine(
     backend: Backend,
     quiet: bool,
 ) -> Result<Engine, Failure> {
-    let run_failure = |e: &dyn std::fmt::Display| Failure {
-        code: 1,
-        message: e.to_string(),
-    };
     match backend {
         Backend::Cpu => Ok(Engine::cpu(start.sim)),
-        Backend::Gpu => GpuSimulation::resume(start)
-            .map(|g| Engine::Gpu(Box::new(g)))
-            .map_err(|e| run_failure(&e)),
+        Backend::Gpu => Ok(Engine::Gpu(Box::new(GpuSimulation::resume(start)?))),
         Backend::Auto => {
             let why = match device::choose_adapter() {
                 Ok(a) if a.get_info().device_type == wgpu::DeviceType::Cpu => format!(
@@ -837,17 +856,15 @@ fn cmd_bench(
         ("--rod-sizes", rod_sizes),
     ] {
         if let Some(n) = list.iter().find(|&&n| !(1..=20_000_000).contains(&n)) {
-            return Err(Failure {
-                code: 2,
-                message: format!("{flag}: {n} particles; each size must be 1 to 2·10⁷"),
-            });
+            return Err(Failure::input(format!(
+                "{flag}: {n} particles; each size must be 1 to 2·10⁷"
+            )));
         }
     }
     if let Some(b) = budget.filter(|b| !(*b > 0.0 && b.is_finite())) {
-        return Err(Failure {
-            code: 2,
-            message: format!("--budget must be a positive number of seconds, got {b}"),
-        });
+        return Err(Failure::input(format!(
+            "--budget must be a positive number of seconds, got {b}"
+        )));
     }
     // A time budget per workload by default, so that the whole bench takes about a
     // minute on any machine; a step count only when asked for.
@@ -864,27 +881,18 @@ fn cmd_bench(
         budget,
         pour,
         &mut |line| eprintln!("{line}"),
-    )
-    .map_err(|e| Failure {
-        code: 1,
-        message: e,
-    })?;
+    )?;
     let text = serde_json::to_string_pretty(&report).expect("report serialises");
     out!("{text}");
     if let Some(path) = out {
-        talus::files::write_atomic(&path, text.as_bytes()).map_err(|e| Failure {
-            code: 1,
-            message: format!("cannot write {}: {e}", path.display()),
-        })?;
+        talus::files::write_atomic(&path, text.as_bytes())
+            .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
     }
     if !report.failures.is_empty() {
-        return Err(Failure {
-            code: 1,
-            message: format!(
-                "{} of the workloads could not run (listed under \"failures\")",
-                report.failures.len()
-            ),
-        });
+        return Err(Failure::failed(format!(
+            "{} of the workloads could not run (listed under \"failures\")",
+            report.failures.len()
+        )));
     }
     Ok(())
 }

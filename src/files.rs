@@ -29,6 +29,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     written
 }
 
+/// Whether a file name is one of `write_atomic`'s temporaries (`.NAME.tmp`).
+pub fn is_temporary(name: &str) -> bool {
+    name.starts_with('.') && name.ends_with(".tmp")
+}
+
 /// Removes the temporaries (`.NAME.tmp`) a killed process left in `dir`; returns how many.
 pub fn remove_stale_temporaries(dir: &Path) -> usize {
     let Ok(entries) = std::fs::read_dir(dir) else {
@@ -36,10 +41,7 @@ pub fn remove_stale_temporaries(dir: &Path) -> usize {
     };
     entries
         .flatten()
-        .filter(|e| {
-            let n = e.file_name().to_string_lossy().into_owned();
-            n.starts_with('.') && n.ends_with(".tmp") && e.path().is_file()
-        })
+        .filter(|e| is_temporary(&e.file_name().to_string_lossy()) && e.path().is_file())
         .filter(|e| std::fs::remove_file(e.path()).is_ok())
         .count()
 }

@@ -72,8 +72,13 @@ fn v(name: &str, scene: &'static str, overrides: &[&str], window: f64, row: f64)
     }
 }
 
+/// A reproduction that does not exist.
+#[derive(Debug, thiserror::Error)]
+#[error("unknown reproduction `{0}`: R1 to R9")]
+pub struct UnknownReproduction(pub String);
+
 /// The runs of reproduction `id` (R1–R9).
-pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
+pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproduction> {
     let r7 = |name: &str, scene: &'static str| v(name, scene, &[], 14.0, 2.0);
     let lattice = |name: &str, set: Vec<String>| {
         let mut x = v(
@@ -319,7 +324,7 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, String> {
                 ]
             }
         }
-        _ => return Err(format!("unknown reproduction `{id}`: R1 to R9")),
+        _ => return Err(UnknownReproduction(id.into())),
     })
 }
 

@@ -1,7 +1,8 @@
 //! Snapshots: the particles and contacts at one step, as little-endian binary columns
 //! (`NAME.bin`) described by JSON metadata (`NAME.json`). The format is documented in
-//! docs/FORMATS.md; `read` loads it back. The `.bin` is renamed into place before the
-//! `.json`, so metadata never points at missing data.
+//! docs/FORMATS.md. `capture` takes one from the state in memory, `write` writes it and
+//! `read` loads it back. The `.bin` is renamed into place before the `.json`, so
+//! metadata never points at missing data.
 
 use crate::contacts::WALL_BASE;
 use crate::files::write_atomic;
@@ -71,43 +72,42 @@ impl Snapshot {
     }
 }
 
+/// Columns in the order they are written, with their byte offsets in the `.bin`.
+#[derive(Default)]
 struct Builder {
-    bytes: Vec<u8>,
-    columns: Vec<ColumnMeta>,
+    size: u64,
+    meta: Vec<ColumnMeta>,
+    columns: BTreeMap<String, Column>,
 }
 
 impl Builder {
     fn push(&mut self, table: &str, name: &str, unit: &str, col: Column) {
-        let offset = self.bytes.len() as u64;
-        let (dtype, count) = match &col {
-            Column::F64(v) => {
-                v.iter()
-                    .for_each(|x| self.bytes.extend_from_slice(&x.to_le_bytes()));
-                ("f64", v.len())
-            }
-            Column::U32(v) => {
-                v.iter()
-                    .for_each(|x| self.bytes.extend_from_slice(&x.to_le_bytes()));
-                ("u32", v.len())
-            }
-            Column::U8(v) => {
-                self.bytes.extend_from_slice(v);
-                ("u8", v.len())
-            }
+        let (dtype, count, width) = match &col {
+            Column::F64(v) => ("f64", v.len(), 8),
+            Column::U32(v) => ("u32", v.len(), 4),
+            Column::U8(v) => ("u8", v.len(), 1),
         };
-        self.columns.push(ColumnMeta {
+        self.meta.push(ColumnMeta {
             table: table.into(),
             name: name.into(),
             dtype: dtype.into(),
             unit: unit.into(),
-            offset,
+            offset: self.size,
             count: count as u64,
         });
+        self.size += (count * width) as u64;
+        self.columns.insert(format!("{table}.{name}"), col);
     }
 }
 
 /// Writes `DIR/STEM.bin` and `DIR/STEM.json`; returns the JSON path.
 pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBuf> {
+    capture(sim, stem).write(dir, stem)
+}
+
+/// The snapshot of the state in memory, as `read` would give it back once written
+/// under `stem`.
+pub fn capture(sim: &Simulation, stem: &str) -> Snapshot {
     let p = &sim.particles;
     let dt = sim.dt();
     let ids: Vec<usize> = (0..p.len()).filter(|&i| p.active[i]).collect();
@@ -122,10 +122,7 @@ pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBu
     } else {
         "m g".to_string()
     };
-    let mut b = Builder {
-        bytes: Vec::new(),
-        columns: Vec::new(),
-    };
+    let mut b = Builder::default();
     b.push(
         "particles",
         "id",
@@ -216,47 +213,133 @@ pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBu
         contacts: c.len() as u64,
         wall_base: WALL_BASE,
         data: format!("{stem}.bin"),
-        columns: b.columns,
+        columns: b.meta,
     };
-    write_atomic(&dir.join(format!("{stem}.bin")), &b.bytes)?;
-    let json_path = dir.join(format!("{stem}.json"));
-    let text = serde_json::to_string_pretty(&meta).map_err(std::io::Error::other)?;
-    write_atomic(&json_path, text.as_bytes())?;
-    Ok(json_path)
+    Snapshot {
+        meta,
+        columns: b.columns,
+    }
+}
+
+impl Snapshot {
+    /// The `.bin`: the columns back to back at their offsets, little-endian.
+    fn encode(&self) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        for c in &self.meta.columns {
+            match self.columns.get(&format!("{}.{}", c.table, c.name)) {
+                Some(Column::F64(v)) => v
+                    .iter()
+                    .for_each(|x| bytes.extend_from_slice(&x.to_le_bytes())),
+                Some(Column::U32(v)) => v
+                    .iter()
+                    .for_each(|x| bytes.extend_from_slice(&x.to_le_bytes())),
+                Some(Column::U8(v)) => bytes.extend_from_slice(v),
+                None => {}
+            }
+        }
+        bytes
+    }
+
+    /// Writes `DIR/STEM.bin`, then `DIR/STEM.json`; returns the JSON path.
+    pub fn write(&self, dir: &Path, stem: &str) -> std::io::Result<PathBuf> {
+        write_atomic(&dir.join(format!("{stem}.bin")), &self.encode())?;
+        let json_path = dir.join(format!("{stem}.json"));
+        let text = serde_json::to_string_pretty(&self.meta).map_err(std::io::Error::other)?;
+        write_atomic(&json_path, text.as_bytes())?;
+        Ok(json_path)
+    }
+}
+
+/// Why a snapshot cannot be read.
+#[derive(Debug, thiserror::Error)]
+pub enum SnapshotError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}: {source}", path.display())]
+    Json {
+        path: PathBuf,
+        source: serde_json::Error,
+    },
+    #[error("{}: not a talus snapshot", .0.display())]
+    NotASnapshot(PathBuf),
+    #[error("column {column}: unknown dtype {dtype}")]
+    UnknownDtype { column: String, dtype: String },
+    #[error("column {column} runs past the end of {}", data.display())]
+    PastTheEnd { column: String, data: PathBuf },
+    #[error("{}: {damage}", path.display())]
+    Damaged { path: PathBuf, damage: Damage },
+}
+
+/// What `check` finds wrong in a snapshot that was read whole.
+#[derive(Debug, thiserror::Error)]
+pub enum Damage {
+    #[error("column {column} holds {len} values, not {want}")]
+    Length {
+        column: String,
+        len: usize,
+        want: u64,
+    },
+    #[error("column {column}: value {index} is {value}")]
+    NotFinite {
+        column: String,
+        index: usize,
+        value: f64,
+    },
+    #[error("{column}: particle {id} is not in the snapshot")]
+    UnknownParticle { column: String, id: u32 },
+}
+
+/// Reads a snapshot's metadata (its `.json`).
+pub fn read_meta(json_path: &Path) -> Result<Meta, SnapshotError> {
+    let path = || json_path.to_path_buf();
+    let text = std::fs::read_to_string(json_path).map_err(|source| SnapshotError::Io {
+        path: path(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|source| SnapshotError::Json {
+        path: path(),
+        source,
+    })
 }
 
 /// Reads a snapshot from its `.json` path.
-pub fn read(json_path: &Path) -> Result<Snapshot, String> {
-    let text =
-        std::fs::read_to_string(json_path).map_err(|e| format!("{}: {e}", json_path.display()))?;
-    let meta: Meta =
-        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", json_path.display()))?;
+pub fn read(json_path: &Path) -> Result<Snapshot, SnapshotError> {
+    let meta = read_meta(json_path)?;
     if meta.format != FORMAT {
-        return Err(format!("{}: not a talus snapshot", json_path.display()));
+        return Err(SnapshotError::NotASnapshot(json_path.to_path_buf()));
     }
     let bin = json_path.with_file_name(&meta.data);
-    let bytes = std::fs::read(&bin).map_err(|e| format!("{}: {e}", bin.display()))?;
+    let bytes = std::fs::read(&bin).map_err(|source| SnapshotError::Io {
+        path: bin.clone(),
+        source,
+    })?;
     let mut columns = BTreeMap::new();
     for c in &meta.columns {
         let size = match c.dtype.as_str() {
             "f64" => 8,
             "u32" => 4,
             "u8" => 1,
-            other => return Err(format!("column {}: unknown dtype {other}", c.name)),
+            other => {
+                return Err(SnapshotError::UnknownDtype {
+                    column: c.name.clone(),
+                    dtype: other.into(),
+                });
+            }
         };
         let start = c.offset as usize;
         let end = (c.count as usize)
             .checked_mul(size)
             .and_then(|n| n.checked_add(start))
             .unwrap_or(usize::MAX);
-        let raw = bytes.get(start..end).ok_or_else(|| {
-            format!(
-                "column {}.{} runs past the end of {}",
-                c.table,
-                c.name,
-                bin.display()
-            )
-        })?;
+        let raw = bytes
+            .get(start..end)
+            .ok_or_else(|| SnapshotError::PastTheEnd {
+                column: format!("{}.{}", c.table, c.name),
+                data: bin.clone(),
+            })?;
         let col = match size {
             8 => Column::F64(
                 raw.chunks_exact(8)
@@ -273,7 +356,10 @@ pub fn read(json_path: &Path) -> Result<Snapshot, String> {
         columns.insert(format!("{}.{}", c.table, c.name), col);
     }
     let snap = Snapshot { meta, columns };
-    check(&snap).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    check(&snap).map_err(|damage| SnapshotError::Damaged {
+        path: json_path.to_path_buf(),
+        damage,
+    })?;
     Ok(snap)
 }
 
@@ -281,7 +367,7 @@ pub fn read(json_path: &Path) -> Result<Snapshot, String> {
 /// indexed out of bounds or drawn with NaN): each table's columns as long as its count,
 /// the corners as many as the particles' corner counts add up to, every number finite,
 /// and each contact between particles of the snapshot (or a wall).
-fn check(s: &Snapshot) -> Result<(), String> {
+fn check(s: &Snapshot) -> Result<(), Damage> {
     let m = &s.meta;
     let len = |c: &Column| match c {
         Column::F64(v) => v.len(),
@@ -300,12 +386,20 @@ fn check(s: &Snapshot) -> Result<(), String> {
             _ => continue,
         };
         if len(c) as u64 != want {
-            return Err(format!("column {key} holds {} values, not {want}", len(c)));
+            return Err(Damage::Length {
+                column: key.clone(),
+                len: len(c),
+                want,
+            });
         }
         if let Column::F64(v) = c
             && let Some(k) = v.iter().position(|x| !x.is_finite())
         {
-            return Err(format!("column {key}: value {k} is {}", v[k]));
+            return Err(Damage::NotFinite {
+                column: key.clone(),
+                index: k,
+                value: v[k],
+            });
         }
     }
     let ids: std::collections::HashSet<u32> = (s.u32("particles.id").unwrap_or(&[]).iter())
@@ -314,7 +408,10 @@ fn check(s: &Snapshot) -> Result<(), String> {
     for key in ["contacts.i", "contacts.j"] {
         for &id in s.u32(key).unwrap_or(&[]) {
             if !ids.contains(&id) && id < m.wall_base {
-                return Err(format!("{key}: particle {id} is not in the snapshot"));
+                return Err(Damage::UnknownParticle {
+                    column: key.into(),
+                    id,
+                });
             }
         }
     }

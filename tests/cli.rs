@@ -384,31 +384,73 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
 }
 
 #[test]
-fn a_reused_output_folder_keeps_no_stale_snapshots_or_checkpoints() {
-    // Issue 16: a fresh run into a folder an earlier run wrote removes that run's
-    // snapshots and checkpoints, so "the newest checkpoint" is this run's.
+fn a_folder_holding_another_run_is_refused_unless_forced() {
+    // Issue 16: a run into a folder an earlier run wrote mixed the two runs' snapshots and
+    // checkpoints; then it silently removed the earlier run's. Now it is refused (exit 2,
+    // nothing touched) unless --force clears them, so "the newest checkpoint" is this
+    // run's.
     let dir = tmp("reused").join("run");
-    let run = |time: &str, every: &str| {
-        let (code, _, err) = talus(&[
-            "run",
-            "-q",
-            "--out",
-            dir.to_str().unwrap(),
-            "--set",
-            "particles[1].count=10",
-            "--set",
-            &format!("stop.time={time}"),
-            "--set",
-            &format!("output.checkpoint_every={every}"),
-            "--set",
-            &format!("output.snapshot_every={every}"),
-        ]);
-        assert_eq!(code, 0, "{err}");
+    let run = |time: &str, every: &str, extra: &[&str]| {
+        let mut args = vec![
+            "run".to_string(),
+            "-q".into(),
+            "--out".into(),
+            dir.to_str().unwrap().into(),
+        ];
+        for set in [
+            "particles[1].count=10".to_string(),
+            format!("stop.time={time}"),
+            format!("output.checkpoint_every={every}"),
+            format!("output.snapshot_every={every}"),
+        ] {
+            args.extend(["--set".into(), set]);
+        }
+        args.extend(extra.iter().map(|s| s.to_string()));
+        talus(&args.iter().map(String::as_str).collect::<Vec<_>>())
     };
-    run("4", "1");
+    let (code, _, err) = run("4", "1", &[]);
+    assert_eq!(code, 0, "{err}");
     let count = |sub: &str| std::fs::read_dir(dir.join(sub)).unwrap().count();
     assert!(count("checkpoints") >= 3 && count("snapshots") >= 10);
-    run("2", "2");
+    let summary = std::fs::read(dir.join("summary.json")).unwrap();
+    let (code, _, err) = run("2", "2", &[]);
+    assert_eq!(code, 2, "{err}");
+    assert!(
+        err.contains(dir.to_str().unwrap()) && err.contains("--force") && err.contains("--resume"),
+        "names the folder and the ways on: {err}"
+    );
+    assert_eq!(std::fs::read(dir.join("summary.json")).unwrap(), summary);
+    assert!(
+        count("checkpoints") >= 3 && count("snapshots") >= 10,
+        "untouched"
+    );
+    // Resuming another folder's run into it is refused too.
+    let other = tmp("reused").join("other");
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--out",
+        other.to_str().unwrap(),
+        "--set",
+        "particles[1].count=10",
+        "--set",
+        "stop.time=1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let ckpt = other.join("checkpoints/ckpt_0000000500.bin");
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--resume",
+        ckpt.to_str().unwrap(),
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        "stop.time=2",
+    ]);
+    assert_eq!(code, 2, "{err}");
+    let (code, _, err) = run("2", "2", &["--force"]);
+    assert_eq!(code, 0, "{err}");
     let names = |sub: &str| -> Vec<String> {
         let mut v: Vec<String> = (std::fs::read_dir(dir.join(sub)).unwrap())
             .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
@@ -426,6 +468,102 @@ fn a_reused_output_folder_keeps_no_stale_snapshots_or_checkpoints() {
             "snap_0000001000.json"
         ]
     );
+    // An empty folder, or one holding other files only, is no other run's.
+    let fresh = tmp("reused").join("fresh");
+    std::fs::create_dir_all(&fresh).unwrap();
+    std::fs::write(fresh.join("notes.txt"), "mine").unwrap();
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--out",
+        fresh.to_str().unwrap(),
+        "--set",
+        "particles[1].count=10",
+        "--set",
+        "stop.time=1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(fresh.join("notes.txt").is_file());
+}
+
+#[cfg(unix)]
+#[test]
+fn an_interrupted_run_stops_cleanly_and_names_its_checkpoint() {
+    // Issue 16: SIGINT (or SIGTERM) stops a run between two advances with exit code 130,
+    // no summary.json (it marks a finished run) and no temporaries, and says where the
+    // last checkpoint is; the run continues from there in its own folder.
+    let dir = tmp("interrupt").join("run");
+    let child = Command::new(env!("CARGO_BIN_EXE_talus"))
+        .args(["run", "-q", "--backend", "cpu", "--out"])
+        .arg(&dir)
+        .args([
+            "--set",
+            "stop.time=1000",
+            "--set",
+            "stop.kinetic_fraction=null",
+            "--set",
+            "output.checkpoint_every=0.5",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    // Interrupt it once it has written a checkpoint.
+    let started = std::time::Instant::now();
+    let has_checkpoint = || {
+        std::fs::read_dir(dir.join("checkpoints")).is_ok_and(|mut d| {
+            d.any(|e| e.is_ok_and(|e| e.file_name().to_string_lossy().starts_with("ckpt_")))
+        })
+    };
+    while !has_checkpoint() {
+        assert!(
+            started.elapsed().as_secs() < 120,
+            "no checkpoint within 2 minutes"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // SAFETY: kill(2) on the child's own process id.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },
+        0
+    );
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted at step"), "{err}");
+    assert!(!dir.join("summary.json").exists(), "no summary: unfinished");
+    for sub in ["", "snapshots", "checkpoints"] {
+        for e in std::fs::read_dir(dir.join(sub)).unwrap() {
+            let name = e.unwrap().file_name().to_string_lossy().into_owned();
+            assert!(!name.ends_with(".tmp"), "temporary {name} left");
+        }
+    }
+    // The checkpoint it names is the newest one, and the run continues from it.
+    let named = err
+        .split("last good checkpoint: ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .unwrap_or_else(|| panic!("names its checkpoint: {err}"));
+    let newest = (std::fs::read_dir(dir.join("checkpoints")).unwrap())
+        .map(|e| e.unwrap().path())
+        .max()
+        .unwrap();
+    assert_eq!(std::path::Path::new(named), newest);
+    let step: u64 = named[named.len() - 14..named.len() - 4].parse().unwrap();
+    let until = format!("stop.time={}", step as f64 * 2e-3 + 0.2);
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--backend",
+        "cpu",
+        "--resume",
+        named,
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        &until,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(dir.join("summary.json").is_file());
 }
 
 #[test]

@@ -29,6 +29,7 @@ fn run_to(dir: &Path, sim: Simulation) {
         &RunOptions {
             out: dir.to_path_buf(),
             quiet: true,
+            ..Default::default()
         },
     )
     .expect("run succeeds");

@@ -2,6 +2,7 @@
 //! the run it belongs to, gravity and friction (`scene.json`) and the energy log
 //! (`log.csv`).
 
+use super::AnalyzeError;
 use crate::geometry::tangent;
 use crate::shape::{P2, area, world};
 use crate::snapshot::{self, Snapshot};
@@ -81,34 +82,32 @@ pub struct Input {
 }
 
 /// The snapshot a path names: a snapshot's .json, or a run folder (its final.json).
-pub fn snapshot_path(path: &Path) -> Result<PathBuf, String> {
+pub fn snapshot_path(path: &Path) -> Result<PathBuf, AnalyzeError> {
     if path.is_dir() {
         let p = path.join("final.json");
         if p.is_file() {
             return Ok(p);
         }
-        return Err(format!(
-            "{}: a run folder needs final.json (the run has not finished; give a snapshot's .json instead)",
-            path.display()
-        ));
+        return Err(AnalyzeError::Unfinished(path.to_path_buf()));
     }
     if path.is_file() {
         return Ok(path.to_path_buf());
     }
-    Err(format!("{}: no such file or folder", path.display()))
+    Err(AnalyzeError::NoSuchPath(path.to_path_buf()))
 }
 
 /// The snapshots of a run folder at times ≥ `from` (not the final one), in time order.
-pub fn snapshots_from(run: &Path, from: f64) -> Result<Vec<PathBuf>, String> {
+pub fn snapshots_from(run: &Path, from: f64) -> Result<Vec<PathBuf>, AnalyzeError> {
     let dir = run.join("snapshots");
     let mut found = Vec::new();
-    let entries = std::fs::read_dir(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let entries = std::fs::read_dir(&dir).map_err(|source| AnalyzeError::Read {
+        path: dir.clone(),
+        source,
+    })?;
     for e in entries.flatten() {
         let p = e.path();
         if p.extension().is_some_and(|x| x == "json") {
-            let text = std::fs::read_to_string(&p).map_err(|e| format!("{}: {e}", p.display()))?;
-            let meta: snapshot::Meta =
-                serde_json::from_str(&text).map_err(|e| format!("{}: {e}", p.display()))?;
+            let meta = snapshot::read_meta(&p)?;
             if meta.time >= from {
                 found.push((meta.time, p));
             }
@@ -148,19 +147,39 @@ fn column<'a, T>(
     s: &'a Snapshot,
     name: &str,
     get: fn(&'a Snapshot, &str) -> Option<&'a [T]>,
-) -> Result<&'a [T], String> {
-    get(s, name).ok_or_else(|| format!("the snapshot has no column {name}"))
+) -> Result<&'a [T], AnalyzeError> {
+    get(s, name).ok_or_else(|| AnalyzeError::MissingColumn(name.into()))
 }
 
-/// Loads a snapshot (or a run folder's final snapshot); `g` overrides gravity.
-pub fn load(path: &Path, g: Option<f64>) -> Result<Input, String> {
+/// Loads a snapshot (or a run folder's final snapshot) with its run's scene and energy
+/// log; `g` overrides gravity.
+pub fn load(path: &Path, g: Option<f64>) -> Result<Input, AnalyzeError> {
     let json = snapshot_path(path)?;
     let s = snapshot::read(&json)?;
-    let f = |name| column(&s, name, Snapshot::f64);
+    let run = run_folder(&json);
+    let scene: Option<serde_json::Value> = run
+        .as_ref()
+        .and_then(|d| std::fs::read_to_string(d.join("scene.json")).ok())
+        .and_then(|t| serde_json::from_str(&t).ok());
+    let mut input = of_snapshot(&s, json, scene.as_ref(), g)?;
+    input.log = run.as_ref().and_then(|d| read_log(&d.join("log.csv")));
+    Ok(input)
+}
+
+/// The input of snapshot `s` of a run of `scene` (as its `scene.json` holds it), read
+/// from `source`, without an energy log: what `load` gives, also for a snapshot still
+/// in memory (`snapshot::capture`). `g` overrides gravity.
+pub fn of_snapshot(
+    s: &Snapshot,
+    source: PathBuf,
+    scene: Option<&serde_json::Value>,
+    g: Option<f64>,
+) -> Result<Input, AnalyzeError> {
+    let f = |name| column(s, name, Snapshot::f64);
     let (xs, zs, th) = (f("particles.x")?, f("particles.z")?, f("particles.theta")?);
     let (rs, ms) = (f("particles.radius")?, f("particles.mass")?);
-    let ids = column(&s, "particles.id", Snapshot::u32)?;
-    let counts = column(&s, "particles.corners", Snapshot::u32)?;
+    let ids = column(s, "particles.id", Snapshot::u32)?;
+    let counts = column(s, "particles.corners", Snapshot::u32)?;
     let (cx, cz) = (
         s.f64("corners.x").unwrap_or(&[]),
         s.f64("corners.z").unwrap_or(&[]),
@@ -211,8 +230,8 @@ pub fn load(path: &Path, g: Option<f64>) -> Result<Input, String> {
             corners,
         });
     }
-    let ci = column(&s, "contacts.i", Snapshot::u32)?;
-    let cj = column(&s, "contacts.j", Snapshot::u32)?;
+    let ci = column(s, "contacts.i", Snapshot::u32)?;
+    let cj = column(s, "contacts.j", Snapshot::u32)?;
     let (nx, nz) = (f("contacts.nx")?, f("contacts.nz")?);
     let (fnm, ftm) = (f("contacts.fn")?, f("contacts.ft")?);
     let (px, pz) = (f("contacts.px")?, f("contacts.pz")?);
@@ -240,28 +259,21 @@ pub fn load(path: &Path, g: Option<f64>) -> Result<Input, String> {
             point: [px[k], pz[k]],
         });
     }
-    let run = run_folder(&json);
-    let scene: Option<serde_json::Value> = run
-        .as_ref()
-        .and_then(|d| std::fs::read_to_string(d.join("scene.json")).ok())
-        .and_then(|t| serde_json::from_str(&t).ok());
-    let scene_g = scene.as_ref().and_then(|v| {
+    let scene_g = scene.and_then(|v| {
         let g = v.pointer("/gravity/g")?.as_array()?;
         let (a, b) = (g.first()?.as_f64()?, g.get(1)?.as_f64()?);
         Some(a.hypot(b))
     });
     let units = s.meta.units.clone();
     let default_g = if units == "si" { 9.81 } else { 1.0 };
-    let mu = scene
-        .as_ref()
-        .and_then(|v| v.pointer("/contact/mu").and_then(|m| m.as_f64()));
+    let mu = scene.and_then(|v| v.pointer("/contact/mu").and_then(|m| m.as_f64()));
     let (length_unit, force_unit) = if units == "si" {
         ("m", "N")
     } else {
         ("sigma", "m g")
     };
     Ok(Input {
-        source: json.clone(),
+        source,
         scene: s.meta.scene.clone(),
         units,
         step: s.meta.step,
@@ -270,7 +282,7 @@ pub fn load(path: &Path, g: Option<f64>) -> Result<Input, String> {
         touches,
         g: g.or(scene_g).unwrap_or(default_g),
         mu,
-        log: run.as_ref().and_then(|d| read_log(&d.join("log.csv"))),
+        log: None,
         length_unit: length_unit.into(),
         force_unit: force_unit.into(),
     })

@@ -16,6 +16,34 @@ use serde::Serialize;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
+/// Why an analysis could not be made or written.
+#[derive(Debug, thiserror::Error)]
+pub enum AnalyzeError {
+    #[error(transparent)]
+    Snapshot(#[from] crate::snapshot::SnapshotError),
+    #[error("{}: no such file or folder", .0.display())]
+    NoSuchPath(PathBuf),
+    #[error(
+        "{}: a run folder needs final.json (the run has not finished; give a snapshot's .json instead)",
+        .0.display()
+    )]
+    Unfinished(PathBuf),
+    #[error("the snapshot has no column {0}")]
+    MissingColumn(String),
+    #[error("{}: the snapshot has no particles", .0.display())]
+    NoParticles(PathBuf),
+    #[error("{}: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
 /// Sizes of the averaging, in mean grain diameters d (the equal-area diameter).
 #[derive(Clone, Debug, Serialize)]
 pub struct Options {
@@ -148,7 +176,7 @@ pub fn analyze_series(
     input: Input,
     earlier: Vec<Input>,
     opt: &Options,
-) -> Result<Analysis, String> {
+) -> Result<Analysis, AnalyzeError> {
     let mut a = analyze(input, opt)?;
     if earlier.is_empty() {
         return Ok(a);
@@ -181,13 +209,10 @@ pub fn analyze_series(
     Ok(a)
 }
 
-pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, String> {
+pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
     let grains = &input.grains;
     if grains.is_empty() {
-        return Err(format!(
-            "{}: the snapshot has no particles",
-            input.source.display()
-        ));
+        return Err(AnalyzeError::NoParticles(input.source.clone()));
     }
     let total_area: f64 = grains.iter().map(|g| g.area).sum();
     let total_mass: f64 = grains.iter().map(|g| g.mass).sum();
@@ -350,17 +375,23 @@ fn table(header: &[String], rows: impl Iterator<Item = Vec<String>>) -> String {
 
 /// Writes the tables and summary.json into `dir` (each file atomically); returns the
 /// files written.
-pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, AnalyzeError> {
+    std::fs::create_dir_all(dir).map_err(|source| AnalyzeError::Write {
+        path: dir.to_path_buf(),
+        source,
+    })?;
     let (l, f) = (&a.input.length_unit, &a.input.force_unit);
     let stress_unit = format!("{f}/{l}");
     let s = &a.summary;
     let o = &s.outline;
     let xs = |x: f64| (x - o.left) / o.width;
     let mut files = Vec::new();
-    let mut put = |name: &str, text: String| -> Result<(), String> {
+    let mut put = |name: &str, text: String| -> Result<(), AnalyzeError> {
         let p = dir.join(name);
-        write_atomic(&p, text.as_bytes()).map_err(|e| format!("{}: {e}", p.display()))?;
+        write_atomic(&p, text.as_bytes()).map_err(|source| AnalyzeError::Write {
+            path: p.clone(),
+            source,
+        })?;
         files.push(p);
         Ok(())
     };
@@ -610,7 +641,8 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
             ),
         )?;
     }
-    let json = serde_json::to_string_pretty(&a.summary).map_err(|e| e.to_string())?;
+    // Plain numbers and strings (NaN becomes null): serialising cannot fail.
+    let json = serde_json::to_string_pretty(&a.summary).expect("a summary serialises");
     put("summary.json", json)?;
     Ok(files)
 }

@@ -13,6 +13,31 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};
 
+/// Why a picture could not be drawn or written.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    #[error("a picture of {width} × {height} pixels is too large")]
+    TooLarge { width: u32, height: u32 },
+    #[error("PNG encoding: {0}")]
+    Png(String),
+    #[error("{}: {message}", path.display())]
+    Plot { path: PathBuf, message: String },
+    #[error("cannot write {}: {source}", path.display())]
+    Write {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+impl RenderError {
+    fn write(path: &Path) -> impl FnOnce(std::io::Error) -> RenderError + '_ {
+        move |source| RenderError::Write {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
+
 /// What colours the grains.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Field {
@@ -129,12 +154,10 @@ struct Canvas {
 }
 
 impl Canvas {
-    fn new(view: View) -> Result<Canvas, String> {
-        let mut pixmap = Pixmap::new(view.width, view.height).ok_or_else(|| {
-            format!(
-                "a picture of {} × {} pixels is too large",
-                view.width, view.height
-            )
+    fn new(view: View) -> Result<Canvas, RenderError> {
+        let mut pixmap = Pixmap::new(view.width, view.height).ok_or(RenderError::TooLarge {
+            width: view.width,
+            height: view.height,
         })?;
         pixmap.fill(Color::WHITE);
         let mut svg = String::new();
@@ -240,15 +263,15 @@ impl Canvas {
             .stroke_path(&path, &paint, &st, Transform::identity(), None);
     }
 
-    fn save(mut self, dir: &Path, stem: &str, files: &mut Vec<PathBuf>) -> Result<(), String> {
+    fn save(mut self, dir: &Path, stem: &str, files: &mut Vec<PathBuf>) -> Result<(), RenderError> {
         self.svg.push_str("</svg>\n");
         let png = self
             .pixmap
             .encode_png()
-            .map_err(|e| format!("PNG encoding: {e}"))?;
+            .map_err(|e| RenderError::Png(e.to_string()))?;
         for (ext, bytes) in [("png", png), ("svg", self.svg.into_bytes())] {
             let p = dir.join(format!("{stem}.{ext}"));
-            write_atomic(&p, &bytes).map_err(|e| format!("{}: {e}", p.display()))?;
+            write_atomic(&p, &bytes).map_err(RenderError::write(&p))?;
             files.push(p);
         }
         Ok(())
@@ -259,8 +282,13 @@ const GREY: [u8; 3] = [200, 200, 200];
 const INK: [u8; 3] = [30, 30, 30];
 
 /// Writes every picture of `a` into `dir`; `width` is the pictures' width in pixels.
-pub fn render(a: &Analysis, dir: &Path, field: Field, width: u32) -> Result<Vec<PathBuf>, String> {
-    std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+pub fn render(
+    a: &Analysis,
+    dir: &Path,
+    field: Field,
+    width: u32,
+) -> Result<Vec<PathBuf>, RenderError> {
+    std::fs::create_dir_all(dir).map_err(RenderError::write(dir))?;
     let mut files = Vec::new();
     let view = View::of(a, width);
     let line = (0.04 * a.summary.mean_diameter * view.scale).clamp(0.3, 2.0) as f32;

@@ -3,6 +3,7 @@
 //! Fig. 3b), P(f/⟨f⟩), f(θ), and P(φ) of the principal stress directions (paper 004
 //! Fig. 5).
 
+use super::RenderError;
 use crate::analyze::Analysis;
 use crate::files::write_atomic;
 use plotters::prelude::*;
@@ -17,7 +18,7 @@ fn plot(
     x_label: &str,
     y_label: &str,
     series: &[Series],
-) -> Result<(), String> {
+) -> Result<(), RenderError> {
     let pts = series
         .iter()
         .flat_map(|s| s.2.iter())
@@ -42,7 +43,10 @@ fn plot(
     let mut text = String::new();
     {
         let root = SVGBackend::with_string(&mut text, (800, 500)).into_drawing_area();
-        let e = |e: &dyn std::fmt::Display| format!("{}: {e}", path.display());
+        let e = |e: &dyn std::fmt::Display| RenderError::Plot {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
         root.fill(&WHITE).map_err(|x| e(&x))?;
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
@@ -80,10 +84,10 @@ fn plot(
         }
         root.present().map_err(|x| e(&x))?;
     }
-    write_atomic(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
+    write_atomic(path, text.as_bytes()).map_err(RenderError::write(path))
 }
 
-pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
+pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError> {
     let o = &a.summary.outline;
     let sc = a.summary.stress_scale;
     let base: Vec<&crate::analyze::stress::Window> =
@@ -180,7 +184,7 @@ pub fn write_profiles(
     path: &Path,
     title: &str,
     profiles: &[(String, Vec<(f64, f64)>)],
-) -> Result<(), String> {
+) -> Result<(), RenderError> {
     const PALETTE: [RGBColor; 8] = [
         BLUE,
         RED,

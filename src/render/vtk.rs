@@ -1,6 +1,7 @@
 //! VTK PolyData (`.vtp`, XML, ASCII) for ParaView: the grains as polygons (disks as
 //! 32-gons) with per-grain fields, and the contact network as lines with forces.
 
+use super::RenderError;
 use crate::analyze::Analysis;
 use crate::files::write_atomic;
 use std::fmt::Write as _;
@@ -32,7 +33,7 @@ struct Piece {
     data: Vec<(String, &'static str, Vec<String>)>,
 }
 
-fn write_piece(path: &Path, p: &Piece) -> Result<(), String> {
+fn write_piece(path: &Path, p: &Piece) -> Result<(), RenderError> {
     let mut s = String::new();
     s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n");
     let (nl, np) = if p.lines {
@@ -80,11 +81,11 @@ fn write_piece(path: &Path, p: &Piece) -> Result<(), String> {
     );
     let _ = writeln!(s, "      </{tag}>");
     s.push_str("    </Piece>\n  </PolyData>\n</VTKFile>\n");
-    write_atomic(path, s.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
+    write_atomic(path, s.as_bytes()).map_err(RenderError::write(path))
 }
 
 /// Writes `grains.vtp` and `contacts.vtp` into `dir`.
-pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, String> {
+pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError> {
     write_named(a, dir, "")
 }
 
@@ -102,7 +103,7 @@ pub fn collection(entries: &[(f64, String, String)]) -> String {
 }
 
 /// Writes `{prefix}grains.vtp` and `{prefix}contacts.vtp` into `dir`.
-pub fn write_named(a: &Analysis, dir: &Path, prefix: &str) -> Result<Vec<PathBuf>, String> {
+pub fn write_named(a: &Analysis, dir: &Path, prefix: &str) -> Result<Vec<PathBuf>, RenderError> {
     let grains = &a.input.grains;
     let mut points = Vec::new();
     let mut cells = Vec::new();

@@ -1,0 +1,116 @@
+//! How a failed command ends: the one place where each library error gets its exit code.
+//! 2: bad input (arguments, scenes, checkpoints, snapshots, an output folder another run
+//! holds); 1: a run or an output that failed (divergence, I/O, no GPU); 130: a run
+//! stopped by SIGINT or SIGTERM.
+
+use std::fmt::Display;
+use talus::analyze::AnalyzeError;
+use talus::bench::BenchError;
+use talus::checkpoint::CheckpointError;
+use talus::gpu::GpuError;
+use talus::render::RenderError;
+use talus::reproduce::UnknownReproduction;
+use talus::run::RunError;
+use talus::scene::SceneError;
+
+pub const INPUT: u8 = 2;
+pub const FAILED: u8 = 1;
+pub const INTERRUPTED: u8 = 130;
+
+/// A failed command: its exit code and the message printed once by `main`.
+#[derive(Debug)]
+pub struct Failure {
+    pub code: u8,
+    pub message: String,
+}
+
+impl Failure {
+    /// Bad input (exit code 2): for the arguments the CLI checks itself.
+    pub fn input(message: impl Display) -> Self {
+        Self::new(INPUT, message)
+    }
+
+    /// A failure of the command (exit code 1).
+    pub fn failed(message: impl Display) -> Self {
+        Self::new(FAILED, message)
+    }
+
+    /// A command stopped by a signal (exit code 130).
+    pub fn interrupted(message: impl Display) -> Self {
+        Self::new(INTERRUPTED, message)
+    }
+
+    fn new(code: u8, message: impl Display) -> Self {
+        Failure {
+            code,
+            message: message.to_string(),
+        }
+    }
+
+    /// The same failure, saying what failed first.
+    pub fn within(self, what: impl Display) -> Self {
+        Failure {
+            message: format!("{what}: {}", self.message),
+            ..self
+        }
+    }
+}
+
+impl From<SceneError> for Failure {
+    fn from(e: SceneError) -> Self {
+        Self::new(INPUT, e)
+    }
+}
+
+impl From<CheckpointError> for Failure {
+    fn from(e: CheckpointError) -> Self {
+        Self::new(INPUT, e)
+    }
+}
+
+impl From<UnknownReproduction> for Failure {
+    fn from(e: UnknownReproduction) -> Self {
+        Self::new(INPUT, e)
+    }
+}
+
+/// Reading a snapshot is input; writing the tables is not.
+impl From<AnalyzeError> for Failure {
+    fn from(e: AnalyzeError) -> Self {
+        let code = match e {
+            AnalyzeError::Write { .. } => FAILED,
+            _ => INPUT,
+        };
+        Self::new(code, e)
+    }
+}
+
+impl From<RenderError> for Failure {
+    fn from(e: RenderError) -> Self {
+        Self::new(FAILED, e)
+    }
+}
+
+impl From<GpuError> for Failure {
+    fn from(e: GpuError) -> Self {
+        Self::new(FAILED, e)
+    }
+}
+
+impl From<BenchError> for Failure {
+    fn from(e: BenchError) -> Self {
+        Self::new(FAILED, e)
+    }
+}
+
+/// A run fails (1) unless its folder holds another run (2) or it was interrupted (130).
+impl From<RunError> for Failure {
+    fn from(e: RunError) -> Self {
+        let code = match e {
+            RunError::FolderInUse { .. } => INPUT,
+            RunError::Interrupted { .. } => INTERRUPTED,
+            _ => FAILED,
+        };
+        Self::new(code, e)
+    }
+}

@@ -1,0 +1,82 @@
+//! The engine a run drives: the CPU reference path or the GPU path, behind one face.
+
+use crate::gpu::{DeviceState, GpuSimulation};
+use crate::sim::{Divergence, Simulation};
+
+/// The path that advances the state: the CPU reference path or the GPU path. Outputs
+/// always read the host `Simulation` (for the GPU, a mirror refreshed by `download`).
+pub enum Engine {
+    Cpu(Box<Simulation>),
+    Gpu(Box<GpuSimulation>),
+}
+
+impl Engine {
+    pub fn cpu(sim: Simulation) -> Self {
+        Self::Cpu(Box::new(sim))
+    }
+
+    /// The host state and, on the GPU path, the exact device state: what a checkpoint
+    /// holds (reads the device back on the GPU path).
+    pub fn checkpoint_state(&mut self) -> (&Simulation, Option<&DeviceState>) {
+        match self {
+            Self::Cpu(s) => (s, None),
+            Self::Gpu(g) => g.checkpoint_state(),
+        }
+    }
+
+    pub fn name(&self) -> String {
+        match self {
+            Self::Cpu(_) => "cpu".into(),
+            Self::Gpu(g) => format!("gpu ({})", g.adapter_name()),
+        }
+    }
+
+    pub fn step(&self) -> u64 {
+        match self {
+            Self::Cpu(s) => s.step,
+            Self::Gpu(g) => g.step(),
+        }
+    }
+
+    /// Active particles now (no readback on the GPU).
+    pub fn active_count(&self) -> u64 {
+        match self {
+            Self::Cpu(s) => s.particles.active_count() as u64,
+            Self::Gpu(g) => g.active_count(),
+        }
+    }
+
+    pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
+        match self {
+            Self::Cpu(s) => s.advance(steps),
+            Self::Gpu(g) => g.advance(steps),
+        }
+    }
+
+    /// The host state, current (reads the device back on the GPU path).
+    pub fn sim(&mut self) -> &Simulation {
+        match self {
+            Self::Cpu(s) => s,
+            Self::Gpu(g) => g.download(),
+        }
+    }
+
+    /// Every particle's position in id order (on the GPU path the state alone is read
+    /// back: observers that follow particles step by step).
+    pub fn positions(&mut self) -> Vec<[f64; 2]> {
+        match self {
+            Self::Cpu(s) => (0..s.particles.len())
+                .map(|i| s.particles.position(i))
+                .collect(),
+            Self::Gpu(g) => g.positions(),
+        }
+    }
+
+    /// The host copy without a readback: scene, law and grid are always current.
+    pub fn host(&self) -> &Simulation {
+        match self {
+            Self::Cpu(s) => s,
+            Self::Gpu(g) => &g.sim,
+        }
+    }
+}

@@ -1,0 +1,252 @@
+//! Driving a run: the step loop and its outputs (`outputs`: snapshots, VTK files,
+//! checkpoints, energy log, each on its own schedule), the settling rule, progress,
+//! divergence and interruption. The output folder holds one run (`folder`); everything
+//! in it is written atomically, and `summary.json` is written last and marks a complete
+//! run.
+
+mod engine;
+pub mod folder;
+pub mod outputs;
+
+pub use engine::Engine;
+
+use crate::files::write_atomic;
+use crate::progress::Progress;
+use crate::sim::{Divergence, Simulation};
+use crate::snapshot;
+use folder::Claimed;
+use outputs::{Outputs, Schedule, Settling};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    pub out: PathBuf,
+    pub quiet: bool,
+    /// Clear another run's outputs found in `out` instead of refusing the folder.
+    pub force: bool,
+    /// The checkpoint the run starts from: one of `out`'s own continues that run there.
+    pub resumed_from: Option<PathBuf>,
+    /// Set (by a signal handler) to stop the run between two advances.
+    pub interrupt: Arc<AtomicBool>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    pub scene: String,
+    pub backend: String,
+    pub steps: u64,
+    pub time: f64,
+    pub particles: usize,
+    pub mobile: usize,
+    pub lost: u64,
+    /// Whether the run ended by the settling rule (else at stop.time).
+    pub settled: bool,
+    pub kinetic_energy: f64,
+    pub elastic_energy: f64,
+    pub wall_seconds: f64,
+    pub particle_steps_per_second: f64,
+    pub final_snapshot: String,
+    pub last_checkpoint: Option<String>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error(
+        "{path} holds another run's outputs ({found}): pass --force to clear them first, or \
+         --resume one of that folder's own checkpoints to continue its run"
+    )]
+    FolderInUse { path: String, found: String },
+    #[error("cannot write {path}: {source}")]
+    Io {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("cannot remove {path}: {source}")]
+    Remove {
+        path: String,
+        source: std::io::Error,
+    },
+    /// A snapshot's VTK files could not be made.
+    #[error(transparent)]
+    Analyze(#[from] crate::analyze::AnalyzeError),
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    #[error("run diverged at step {step} (t = {time:.6e}): {cause}; {checkpoint}")]
+    Diverged {
+        step: u64,
+        time: f64,
+        cause: Divergence,
+        checkpoint: String,
+    },
+    #[error(
+        "run interrupted at step {step} (t = {time:.6e}), unfinished (no summary.json); {checkpoint}"
+    )]
+    Interrupted {
+        step: u64,
+        time: f64,
+        checkpoint: String,
+    },
+}
+
+fn io(path: &Path) -> impl FnOnce(std::io::Error) -> RunError + '_ {
+    move |source| RunError::Io {
+        path: path.display().to_string(),
+        source,
+    }
+}
+
+/// The step at which the run ends at the latest.
+pub fn total_steps(sim: &Simulation) -> u64 {
+    (sim.scene.stop.time / sim.dt() - 1e-9).ceil() as u64
+}
+
+/// Where to continue from: the newest checkpoint, in words for an error message.
+fn resume_hint(checkpoint: Option<&Path>, what: &str) -> String {
+    match checkpoint {
+        Some(p) => format!(
+            "last good checkpoint: {} (continue with `talus run --resume {}`)",
+            p.display(),
+            p.display()
+        ),
+        None => {
+            format!("no checkpoint was written before the {what} (see output.checkpoint_every)")
+        }
+    }
+}
+
+/// Runs `engine` to the end of its scene (or until it settles), writing into
+/// `opts.out`; the folder is claimed first (`folder::claim`).
+pub fn run(engine: &mut Engine, opts: &RunOptions) -> Result<RunSummary, RunError> {
+    let claimed = folder::claim(
+        &opts.out,
+        engine.step(),
+        opts.resumed_from.as_deref(),
+        opts.force,
+    )?;
+    let result = drive(engine, opts, claimed);
+    if result.is_err() {
+        // Whatever stopped the run, no half-written file stays behind.
+        folder::remove_temporaries(&opts.out);
+    }
+    result
+}
+
+fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<RunSummary, RunError> {
+    let out = &opts.out;
+    let start_step = engine.step();
+    let total = total_steps(engine.host());
+    let mut progress = Progress::new(start_step, total, opts.quiet);
+    note_claim(&progress, &claimed, out, start_step);
+    let scene = engine.host().scene.clone();
+    let scene_path = out.join("scene.json");
+    let text = serde_json::to_string_pretty(&scene).expect("a scene always serialises");
+    write_atomic(&scene_path, text.as_bytes()).map_err(io(&scene_path))?;
+
+    let mut outputs = Outputs::new(&scene, out, start_step);
+    let mut settling = Settling::new(&scene);
+    // Progress between checks as well, so that the engine runs freely in between (on
+    // the GPU: many steps per submission).
+    let progress_every = Schedule::steps(256);
+    let time = |step: u64| step as f64 * scene.dt;
+    // The checkpoint to continue from if the run stops here.
+    let resume_from = |o: &Outputs| {
+        (o.last_checkpoint())
+            .or(opts.resumed_from.as_deref())
+            .map(Path::to_path_buf)
+    };
+
+    let start = Instant::now();
+    let mut particle_steps = 0u64;
+    let mut settled = false;
+    if start_step == 0 {
+        outputs.write_start(engine)?;
+    }
+    while engine.step() < total {
+        let now = engine.step();
+        if opts.interrupt.load(Ordering::Relaxed) {
+            progress.finish();
+            return Err(RunError::Interrupted {
+                step: now,
+                time: time(now),
+                checkpoint: resume_hint(resume_from(&outputs).as_deref(), "interruption"),
+            });
+        }
+        // The next step at which anything happens: an output, the settling check, or a
+        // progress update.
+        let next = (outputs.next_after(now))
+            .min(settling.every.next_after(now))
+            .min(progress_every.next_after(now))
+            .min(total);
+        let active = engine.active_count();
+        if let Err(cause) = engine.advance(next - now) {
+            progress.finish();
+            let step = engine.step();
+            return Err(RunError::Diverged {
+                step,
+                time: time(step),
+                cause,
+                checkpoint: resume_hint(resume_from(&outputs).as_deref(), "divergence"),
+            });
+        }
+        particle_steps += active * (next - now);
+        let step = next;
+        outputs.write_due(engine)?;
+        if settling.every.due(step) {
+            progress.update(step, time(step), engine.active_count() as usize);
+            if settling.settled(engine, time(step), &progress) {
+                settled = true;
+                break;
+            }
+        } else if progress_every.due(step) {
+            progress.update(step, time(step), engine.active_count() as usize);
+        }
+    }
+    progress.finish();
+    let backend = engine.name();
+    outputs.write_end(engine)?;
+    let sim = engine.sim();
+    let final_json = snapshot::write(sim, out, "final").map_err(io(out))?;
+    let wall = start.elapsed().as_secs_f64();
+    let e = sim.energies();
+    let summary = RunSummary {
+        scene: sim.scene.name.clone(),
+        backend,
+        steps: sim.step - start_step,
+        time: sim.time(),
+        particles: sim.particles.active_count(),
+        mobile: sim.particles.mobile_count(),
+        lost: sim.lost,
+        settled,
+        kinetic_energy: e.kinetic(),
+        elastic_energy: e.elastic,
+        wall_seconds: wall,
+        particle_steps_per_second: particle_steps as f64 / wall.max(1e-9),
+        final_snapshot: final_json.display().to_string(),
+        last_checkpoint: outputs.last_checkpoint().map(|p| p.display().to_string()),
+    };
+    let text = serde_json::to_string_pretty(&summary).expect("summary serialises");
+    let summary_path = out.join("summary.json");
+    write_atomic(&summary_path, text.as_bytes()).map_err(io(&summary_path))?;
+    Ok(summary)
+}
+
+/// Says what `folder::claim` removed.
+fn note_claim(progress: &Progress, claimed: &Claimed, out: &Path, start_step: u64) {
+    match claimed {
+        Claimed::Cleared(found) => progress.note(&format!(
+            "talus: --force: removed another run's {} from {}",
+            found.join(", "),
+            out.display()
+        )),
+        Claimed::Resumed(n) if *n > 0 => progress.note(&format!(
+            "talus: removed {n} snapshot and checkpoint files past step {start_step} from {} \
+             (this run writes them again)",
+            out.display()
+        )),
+        _ => {}
+    }
+}
