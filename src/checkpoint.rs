@@ -125,11 +125,8 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
     e.bytes
 }
 
-/// FNV-1a (64 bits) over the bytes: any one-byte change alters it.
 fn checksum(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
-    })
+    crate::files::fnv1a64(crate::files::FNV_START, bytes)
 }
 
 /// The tag of the spheropolygon section at a checkpoint's end.

@@ -12,7 +12,9 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 pub const FORMAT: &str = "talus-snapshot";
-pub const VERSION: u32 = 1;
+/// 2: the metadata carries a checksum of itself and the data (version 1 files, without
+/// one, are still read).
+pub const VERSION: u32 = 2;
 
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct ColumnMeta {
@@ -41,6 +43,10 @@ pub struct Meta {
     pub wall_base: u32,
     pub data: String,
     pub columns: Vec<ColumnMeta>,
+    /// "fnv1a64:" and 16 hex digits: FNV-1a over the `.bin` and then this metadata
+    /// without the checksum, as compact JSON (`digest`). A snapshot in memory has none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub checksum: Option<String>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -214,6 +220,7 @@ pub fn capture(sim: &Simulation, stem: &str) -> Snapshot {
         wall_base: WALL_BASE,
         data: format!("{stem}.bin"),
         columns: b.meta,
+        checksum: None,
     };
     Snapshot {
         meta,
@@ -240,14 +247,33 @@ impl Snapshot {
         bytes
     }
 
-    /// Writes `DIR/STEM.bin`, then `DIR/STEM.json`; returns the JSON path.
+    /// Writes `DIR/STEM.bin`, then `DIR/STEM.json` with the checksum of both; returns
+    /// the JSON path.
     pub fn write(&self, dir: &Path, stem: &str) -> std::io::Result<PathBuf> {
-        write_atomic(&dir.join(format!("{stem}.bin")), &self.encode())?;
+        let bin = self.encode();
+        write_atomic(&dir.join(format!("{stem}.bin")), &bin)?;
         let json_path = dir.join(format!("{stem}.json"));
-        let text = serde_json::to_string_pretty(&self.meta).map_err(std::io::Error::other)?;
+        let meta = Meta {
+            checksum: Some(digest(&self.meta, &bin)),
+            ..self.meta.clone()
+        };
+        let text = serde_json::to_string_pretty(&meta).map_err(std::io::Error::other)?;
         write_atomic(&json_path, text.as_bytes())?;
         Ok(json_path)
     }
+}
+
+/// The checksum of a snapshot: FNV-1a over its data and then its metadata without the
+/// checksum (compact JSON), so that a changed byte in either file is noticed; whitespace
+/// in the `.json` does not count (it changes no value).
+fn digest(meta: &Meta, bin: &[u8]) -> String {
+    use crate::files::{FNV_START, fnv1a64};
+    let bare = Meta {
+        checksum: None,
+        ..meta.clone()
+    };
+    let text = serde_json::to_vec(&bare).unwrap_or_default();
+    format!("fnv1a64:{:016x}", fnv1a64(fnv1a64(FNV_START, bin), &text))
 }
 
 /// Why a snapshot cannot be read.
@@ -271,6 +297,13 @@ pub enum SnapshotError {
     PastTheEnd { column: String, data: PathBuf },
     #[error("{}: {damage}", path.display())]
     Damaged { path: PathBuf, damage: Damage },
+    #[error(
+        "snapshot {} is damaged: its checksum does not match its data and metadata",
+        .0.display()
+    )]
+    Checksum(PathBuf),
+    #[error("{}: version {found} of the snapshot format is newer than this talus reads ({VERSION})", path.display())]
+    Newer { path: PathBuf, found: u32 },
 }
 
 /// What `check` finds wrong in a snapshot that was read whole.
@@ -311,11 +344,25 @@ pub fn read(json_path: &Path) -> Result<Snapshot, SnapshotError> {
     if meta.format != FORMAT {
         return Err(SnapshotError::NotASnapshot(json_path.to_path_buf()));
     }
+    if meta.version > VERSION {
+        return Err(SnapshotError::Newer {
+            path: json_path.to_path_buf(),
+            found: meta.version,
+        });
+    }
+    // The data lies beside the metadata: a plain file name, never a path to elsewhere.
+    if Path::new(&meta.data).file_name() != Some(std::ffi::OsStr::new(&meta.data)) {
+        return Err(SnapshotError::NotASnapshot(json_path.to_path_buf()));
+    }
     let bin = json_path.with_file_name(&meta.data);
     let bytes = std::fs::read(&bin).map_err(|source| SnapshotError::Io {
         path: bin.clone(),
         source,
     })?;
+    // From version 2 on a snapshot must carry its checksum; one without it was edited.
+    if meta.version >= 2 && meta.checksum.as_deref() != Some(digest(&meta, &bytes).as_str()) {
+        return Err(SnapshotError::Checksum(json_path.to_path_buf()));
+    }
     let mut columns = BTreeMap::new();
     for c in &meta.columns {
         let size = match c.dtype.as_str() {
