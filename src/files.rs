@@ -117,6 +117,16 @@ impl<'a> Decoder<'a> {
     }
 }
 
+/// FNV-1a (64 bits) over the bytes, continuing from `h` (start with `FNV_START`): any
+/// one-byte change alters it. Checkpoints and snapshots carry it (issue 16).
+pub fn fnv1a64(h: u64, bytes: &[u8]) -> u64 {
+    bytes
+        .iter()
+        .fold(h, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
+}
+
+pub const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -136,13 +146,3 @@ mod tests {
         std::fs::remove_dir_all(&dir).ok();
     }
 }
-
-/// FNV-1a (64 bits) over the bytes, continuing from `h` (start with `FNV_START`): any
-/// one-byte change alters it. Checkpoints and snapshots carry it (issue 16).
-pub fn fnv1a64(h: u64, bytes: &[u8]) -> u64 {
-    bytes
-        .iter()
-        .fold(h, |h, &b| (h ^ b as u64).wrapping_mul(0x0100_0000_01b3))
-}
-
-pub const FNV_START: u64 = 0xcbf2_9ce4_8422_2325;
