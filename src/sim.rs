@@ -44,6 +44,9 @@ pub enum Divergence {
         "particle {id} moves by {ratio:.3} of its radius in one step (limits.max_step_displacement = {limit}): it would pass through its neighbours without meeting them; a smaller dt, or a softer start"
     )]
     TooFast { id: u32, ratio: f64, limit: f64 },
+    /// Not the physics: the GPU could not be read back (the device was lost).
+    #[error("{0}")]
+    Device(String),
 }
 
 /// The shortest `Simulation::advance` that sorts the particles in memory: sorting and

@@ -33,7 +33,7 @@ fn block_on_incline(path: Path, tan_theta: f64) -> Option<(f64, f64, f64)> {
     let mut e = engine(path, "block_on_incline", sim(&v))?;
     // settle the normal contact and the spring
     e.advance(20_000).unwrap();
-    let s = e.sim();
+    let s = e.sim().unwrap();
     let (x0, v0, dt) = (
         s.particles.position(6)[0],
         s.particles.velocity(6, s.dt())[0],
@@ -41,7 +41,7 @@ fn block_on_incline(path: Path, tan_theta: f64) -> Option<(f64, f64, f64)> {
     );
     let t = 2.0;
     e.advance((t / dt) as u64).unwrap();
-    let s = e.sim();
+    let s = e.sim().unwrap();
     let x1 = s.particles.position(6)[0];
     let v1 = s.particles.velocity(6, s.dt())[0];
     let k = s

@@ -50,7 +50,7 @@ fn settle_on(path: Path, v: &Value, time: f64) -> Option<Simulation> {
     let steps = (time / s.dt()).round() as u64;
     let mut e = engine(path, "rods", s)?;
     e.advance(steps).expect("the rods settle");
-    Some(e.sim().clone())
+    Some(e.sim().unwrap().clone())
 }
 
 /// How close each path comes to the analytic overlaps: f64 on the CPU, f32 forces on

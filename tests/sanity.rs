@@ -104,7 +104,7 @@ fn a_particle_faster_than_the_bound_stops_the_run_on_both_paths() {
             continue;
         };
         free.advance(4).expect("nothing stops it without the guard");
-        let z = free.sim().particles.position(11)[1];
+        let z = free.sim().unwrap().particles.position(11)[1];
         assert!(z < -1.0, "{path:?}: the disk went through the row: z = {z}");
 
         let mut guarded = engine(path, "tunnelling", shot_at_a_row(2.5, 0.5)).unwrap();
@@ -138,4 +138,23 @@ fn a_source_whose_outlet_reaches_beyond_the_domain_is_named() {
     assert!(e.contains("particles[0].spread") && e.contains("(110, 50)"), "{e}");
     v["particles"][0]["spread"] = json!(5.0);
     assert!(build(&v, &[]).is_ok());
+}
+
+#[test]
+fn a_lost_gpu_stops_the_run_with_an_error_not_a_panic() {
+    let sim = shot_at_a_row(0.01, 0.5);
+    let Some(mut e) = engine(common::Path::Gpu, "lost device", sim) else {
+        return;
+    };
+    e.advance(10).expect("runs while the device is there");
+    let talus::run::Engine::Gpu(g) = &e else {
+        unreachable!()
+    };
+    g.destroy_device_for_test();
+    match e.advance(10) {
+        Err(Divergence::Device(reason)) => assert!(!reason.is_empty()),
+        other => panic!("expected a device failure, got {other:?}"),
+    }
+    assert!(e.sim().is_err(), "no state is read from a lost device");
+    assert!(e.checkpoint_state().is_err());
 }

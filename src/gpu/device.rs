@@ -120,6 +120,10 @@ pub struct Gpu {
     pub queue: wgpu::Queue,
     pub info: wgpu::AdapterInfo,
     pub limits: wgpu::Limits,
+    /// The first error the device reported (lost, out of memory, a failed readback):
+    /// wgpu's default handler would panic; talus notes it here and the run stops with it
+    /// at its next check (`GpuSimulation::failure`; issue 16 item 8).
+    pub failure: std::sync::Arc<std::sync::Mutex<Option<String>>>,
 }
 
 impl Gpu {
@@ -150,12 +154,32 @@ impl Gpu {
                 name: info.name.clone(),
                 reason: e.to_string(),
             })?;
+        let failure: std::sync::Arc<std::sync::Mutex<Option<String>>> = Default::default();
+        let slot = failure.clone();
+        device.on_uncaptured_error(std::sync::Arc::new(move |e: wgpu::Error| {
+            note(&slot, e.to_string())
+        }));
+        let slot = failure.clone();
+        device.set_device_lost_callback(move |why, message| {
+            note(&slot, format!("the device was lost ({why:?}): {message}"))
+        });
         Ok(Self {
             device,
             queue,
             info,
             limits,
+            failure,
         })
+    }
+
+    /// Notes a failure of the device (the first one is kept).
+    pub fn note_failure(&self, reason: String) {
+        note(&self.failure, reason)
+    }
+
+    /// The first failure the device reported, if any.
+    pub fn failure(&self) -> Option<String> {
+        self.failure.lock().unwrap_or_else(|p| p.into_inner()).clone()
     }
 
     /// Checks a buffer of `bytes` against the device limits before allocating it.
@@ -236,4 +260,10 @@ pub fn describe() -> String {
         ),
     };
     s
+}
+
+fn note(slot: &std::sync::Mutex<Option<String>>, reason: String) {
+    slot.lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .get_or_insert(reason);
 }

@@ -18,6 +18,8 @@ pub(super) struct Batch {
     pub(super) staging: wgpu::Buffer,
     pub(super) index: wgpu::SubmissionIndex,
     pub(super) steps: u64,
+    /// Its readback's mapping outcome.
+    pub(super) mapped: super::transfer::MapFlag,
 }
 
 /// The stages of a rebuild of the neighbour lists, in order: the old lists' springs into
@@ -306,6 +308,10 @@ impl GpuSimulation {
             let batch = in_flight.pop_front().expect("a batch in flight");
             let done = batch.steps;
             let c = self.wait_for(batch);
+            if let Some(e) = self.failure() {
+                in_flight.clear();
+                return Err(Divergence::Device(e.to_string()));
+            }
             self.live = c[control::LIVE];
             self.lost_now = c[control::LOST] as u64;
             if c[control::HALT] != 0 {
@@ -353,29 +359,44 @@ impl GpuSimulation {
         }
         enc.copy_buffer_to_buffer(&self.buffers.control, 0, &staging, 0, (words * 4) as u64);
         let index = self.gpu.queue.submit([enc.finish()]);
+        let mapped = self.map_flag();
+        let flag = mapped.clone();
         staging
             .slice(..)
-            .map_async(wgpu::MapMode::Read, |r| r.expect("GPU readback failed"));
+            .map_async(wgpu::MapMode::Read, move |r| flag.set(r));
         self.submissions.set(self.submissions.get() + 1);
         self.synced = false;
         Batch {
             staging,
             index,
             steps: k,
+            mapped,
         }
     }
 
-    /// Waits until a batch is done and returns the control words it left.
+    /// Waits until a batch is done and returns the control words it left (zeros, and
+    /// the failure noted, when the device cannot be read: `failure`).
     pub(super) fn wait_for(&self, batch: Batch) -> Vec<u32> {
-        self.gpu
-            .device
-            .poll(wgpu::PollType::Wait {
-                submission_index: Some(batch.index),
-                timeout: None,
-            })
-            .expect("GPU device lost");
-        let view = batch.staging.slice(..).get_mapped_range().expect("mapped");
-        bytemuck::cast_slice::<u8, u32>(&view[..]).to_vec()
+        let words = control::BLOCKED;
+        let polled = self.gpu.device.poll(wgpu::PollType::Wait {
+            submission_index: Some(batch.index),
+            timeout: None,
+        });
+        if let Err(e) = polled {
+            self.note_failure(format!("the device was lost: {e}"));
+            return vec![0; words];
+        }
+        if let Err(e) = batch.mapped.outcome() {
+            self.note_failure(e);
+            return vec![0; words];
+        }
+        match batch.staging.slice(..).get_mapped_range() {
+            Ok(view) => bytemuck::cast_slice::<u8, u32>(&view[..]).to_vec(),
+            Err(e) => {
+                self.note_failure(e.to_string());
+                vec![0; words]
+            }
+        }
     }
 
     pub(super) fn halt_cause(&mut self, c: &[u32]) -> Divergence {

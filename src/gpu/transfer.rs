@@ -325,17 +325,75 @@ impl GpuSimulation {
         self.gpu.queue.submit([enc.finish()]);
         self.submissions.set(self.submissions.get() + 1);
         let slice = staging.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |r| r.expect("GPU readback failed"));
-        self.gpu
-            .device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .expect("GPU device lost");
-        let view = slice.get_mapped_range().expect("mapped");
+        let mapped = self.map_flag();
+        let flag = mapped.clone();
+        slice.map_async(wgpu::MapMode::Read, move |r| flag.set(r));
+        let polled = self.gpu.device.poll(wgpu::PollType::wait_indefinitely());
+        if let Err(e) = polled {
+            return self.failed(format!("the device was lost: {e}"), count);
+        }
+        if let Err(e) = mapped.outcome() {
+            return self.failed(e, count);
+        }
+        let view = match slice.get_mapped_range() {
+            Ok(view) => view,
+            Err(e) => return self.failed(format!("{e}"), count),
+        };
         let out = bytemuck::cast_slice::<u8, T>(&view[..count * size as usize]).to_vec();
         drop(view);
         staging.unmap();
         out
     }
+
+    /// A readback that failed: noted (the first reason is kept), zeros in its place.
+    fn failed<T: bytemuck::Pod>(&self, reason: String, count: usize) -> Vec<T> {
+        self.note_failure(reason);
+        vec![T::zeroed(); count]
+    }
+
+    pub(super) fn note_failure(&self, reason: String) {
+        self.gpu.note_failure(reason)
+    }
+
+    /// Why the device failed, if it did (a readback, a lost device, an error it
+    /// reported): from then on reads return zeros and no state read can be trusted. The
+    /// run loop asks before it uses a read (issue 16 item 8: no panic on a lost device).
+    pub fn failure(&self) -> Option<GpuError> {
+        self.gpu.failure().map(GpuError::Readback)
+    }
+
+    /// Destroys the device, as a driver reset or an unplugged GPU would (tests: a run
+    /// must stop with an error, not a panic).
+    #[doc(hidden)]
+    pub fn destroy_device_for_test(&self) {
+        self.gpu.device.destroy();
+    }
+
+    /// Where a `map_async` callback leaves its outcome for the thread that polled.
+    pub(super) fn map_flag(&self) -> MapFlag {
+        MapFlag::default()
+    }
+}
+
+/// The outcome of a `map_async`, handed from its callback to the thread that polled.
+#[derive(Clone, Default)]
+pub(super) struct MapFlag(std::sync::Arc<std::sync::Mutex<Option<Result<(), String>>>>);
+
+impl MapFlag {
+    pub(super) fn set(&self, r: Result<(), wgpu::BufferAsyncError>) {
+        let mut o = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        *o = Some(r.map_err(|e| e.to_string()));
+    }
+
+    /// Ok once mapped; the reason otherwise (also when the callback has not run).
+    pub(super) fn outcome(&self) -> Result<(), String> {
+        let o = self.0.lock().unwrap_or_else(|p| p.into_inner());
+        o.clone()
+            .unwrap_or_else(|| Err("the buffer was not mapped after the wait".into()))
+    }
+}
+
+impl GpuSimulation {
 
     pub(super) fn write_buffer<T: bytemuck::Pod>(&mut self, buf: &wgpu::Buffer, data: &[T]) {
         self.gpu

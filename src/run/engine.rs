@@ -1,6 +1,6 @@
 //! The engine a run drives: the CPU reference path or the GPU path, behind one face.
 
-use crate::gpu::{DeviceState, GpuSimulation};
+use crate::gpu::{DeviceState, GpuError, GpuSimulation};
 use crate::sim::{Divergence, Simulation};
 
 /// The path that advances the state: the CPU reference path or the GPU path. Outputs
@@ -16,11 +16,17 @@ impl Engine {
     }
 
     /// The host state and, on the GPU path, the exact device state: what a checkpoint
-    /// holds (reads the device back on the GPU path).
-    pub fn checkpoint_state(&mut self) -> (&Simulation, Option<&DeviceState>) {
+    /// holds (reads the device back on the GPU path; an error when it could not).
+    pub fn checkpoint_state(&mut self) -> Result<(&Simulation, Option<&DeviceState>), GpuError> {
         match self {
-            Self::Cpu(s) => (s, None),
-            Self::Gpu(g) => g.checkpoint_state(),
+            Self::Cpu(s) => Ok((s, None)),
+            Self::Gpu(g) => {
+                g.download();
+                match g.failure() {
+                    Some(e) => Err(e),
+                    None => Ok(g.checkpoint_state()),
+                }
+            }
         }
     }
 
@@ -53,11 +59,18 @@ impl Engine {
         }
     }
 
-    /// The host state, current (reads the device back on the GPU path).
-    pub fn sim(&mut self) -> &Simulation {
+    /// The host state, current (reads the device back on the GPU path): an error when
+    /// the device could not be read, so that nothing is written from a failed readback.
+    pub fn sim(&mut self) -> Result<&Simulation, GpuError> {
         match self {
-            Self::Cpu(s) => s,
-            Self::Gpu(g) => g.download(),
+            Self::Cpu(s) => Ok(s),
+            Self::Gpu(g) => {
+                g.download();
+                match g.failure() {
+                    Some(e) => Err(e),
+                    None => Ok(&g.sim),
+                }
+            }
         }
     }
 

@@ -75,6 +75,16 @@ pub enum RunError {
     Analyze(#[from] crate::analyze::AnalyzeError),
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
+    /// The GPU could not be read back: nothing after the last checkpoint is trusted.
+    #[error("the GPU failed: {0}")]
+    Device(#[from] crate::gpu::GpuError),
+    #[error("the GPU failed at step {step} (t = {time:.6e}): {reason}; {checkpoint}")]
+    DeviceLost {
+        step: u64,
+        time: f64,
+        reason: String,
+        checkpoint: String,
+    },
     #[error("run diverged at step {step} (t = {time:.6e}): {cause}; {checkpoint}")]
     Diverged {
         step: u64,
@@ -185,11 +195,20 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
         if let Err(cause) = engine.advance(next - now) {
             progress.finish();
             let step = engine.step();
-            return Err(RunError::Diverged {
-                step,
-                time: time(step),
-                cause,
-                checkpoint: resume_hint(resume_from(&outputs).as_deref(), "divergence"),
+            let time = time(step);
+            return Err(match cause {
+                Divergence::Device(reason) => RunError::DeviceLost {
+                    step,
+                    time,
+                    reason,
+                    checkpoint: resume_hint(resume_from(&outputs).as_deref(), "failure"),
+                },
+                cause => RunError::Diverged {
+                    step,
+                    time,
+                    cause,
+                    checkpoint: resume_hint(resume_from(&outputs).as_deref(), "divergence"),
+                },
             });
         }
         particle_steps += active * (next - now);
@@ -197,7 +216,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
         outputs.write_due(engine)?;
         if settling.every.due(step) {
             progress.update(step, time(step), engine.active_count() as usize);
-            if settling.settled(engine, time(step), &progress) {
+            if settling.settled(engine, time(step), &progress)? {
                 settled = true;
                 break;
             }
@@ -208,7 +227,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
     progress.finish();
     let backend = engine.name();
     outputs.write_end(engine)?;
-    let sim = engine.sim();
+    let sim = engine.sim()?;
     let final_json = snapshot::write(sim, out, "final").map_err(io(out))?;
     let wall = start.elapsed().as_secs_f64();
     let e = sim.energies();

@@ -219,7 +219,7 @@ impl Output for Log {
     fn write(&mut self, engine: &mut Engine) -> Result<(), RunError> {
         let step = engine.step();
         if self.rows.due(step) {
-            self.row(step, engine.sim());
+            self.row(step, engine.sim()?);
         }
         if self.saves.due(step) {
             self.save()?;
@@ -247,7 +247,7 @@ impl Output for Snapshots {
     }
     fn write(&mut self, engine: &mut Engine) -> Result<(), RunError> {
         let stem = snapshot_stem(engine.step());
-        snapshot::write(engine.sim(), &self.dir, &stem).map_err(io(&self.dir))?;
+        snapshot::write(engine.sim()?, &self.dir, &stem).map_err(io(&self.dir))?;
         Ok(())
     }
 }
@@ -273,7 +273,7 @@ impl Output for Vtk {
     }
     fn write(&mut self, engine: &mut Engine) -> Result<(), RunError> {
         let stem = snapshot_stem(engine.step());
-        let sim = engine.sim();
+        let sim = engine.sim()?;
         // The snapshot's analysis, from the state in memory: what `talus analyze` finds
         // in the snapshot file.
         let snap = snapshot::capture(sim, &stem);
@@ -318,7 +318,7 @@ impl Output for Checkpoints {
         self.every.next_after(step)
     }
     fn write(&mut self, engine: &mut Engine) -> Result<(), RunError> {
-        let (sim, device) = engine.checkpoint_state();
+        let (sim, device) = engine.checkpoint_state()?;
         let path = self.dir.join(format!("ckpt_{:010}.bin", sim.step));
         checkpoint::write(sim, device, &path).map_err(io(&path))?;
         self.written.push(path);
@@ -357,16 +357,21 @@ impl Settling {
     }
 
     /// Whether the run has settled at `time`; says so through `progress`.
-    pub fn settled(&mut self, engine: &mut Engine, time: f64, progress: &Progress) -> bool {
+    pub fn settled(
+        &mut self,
+        engine: &mut Engine,
+        time: f64,
+        progress: &Progress,
+    ) -> Result<bool, RunError> {
         if time < self.not_before {
-            return false;
+            return Ok(false);
         }
         if let Some(drop) = self.kinetic_drop
-            && engine.sim().feeding_done()
+            && engine.sim()?.feeding_done()
         {
             // Paper 004's rule: the mean kinetic energy against its value when the
             // relaxation began (the first check after the sources are done).
-            let sim = engine.sim();
+            let sim = engine.sim()?;
             let n = sim.particles.active_count().max(1) as f64;
             let mean = sim.energies().kinetic() / n;
             let start = *self.relaxing_from.get_or_insert(mean);
@@ -376,11 +381,11 @@ impl Settling {
                     sim.time(),
                     mean / start
                 ));
-                return true;
+                return Ok(true);
             }
         }
         if let Some(frac) = self.kinetic_fraction {
-            let sim = engine.sim();
+            let sim = engine.sim()?;
             if sim.feeding_done() {
                 let e = sim.energies();
                 if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
@@ -389,10 +394,10 @@ impl Settling {
                         sim.time(),
                         e.kinetic() / e.elastic
                     ));
-                    return true;
+                    return Ok(true);
                 }
             }
         }
-        false
+        Ok(false)
     }
 }

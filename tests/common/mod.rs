@@ -146,7 +146,7 @@ pub fn head_on_on(
     // the contact (a few steps).
     e.advance(200).expect("no divergence");
     assert!(overlap(&mut e).1 < 0.0, "apart");
-    let s = e.sim();
+    let s = e.sim().unwrap();
     let vel = |i| s.particles.velocity(i, s.dt())[0];
     let v_out = vel(1) - vel(0);
     Some((t_out - t_in, v_out / v0))
