@@ -159,7 +159,11 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
     if bytes.len() >= 8 && &bytes[..8] == OLD_MAGIC {
         return Err(CheckpointError::OldFormat(name));
     }
-    let body = if bytes.len() >= 16 && &bytes[..8] == MAGIC {
+    let body = if bytes.starts_with(MAGIC) {
+        // Too short to hold the checksum: cut off, not foreign.
+        if bytes.len() < 16 {
+            return Err(CheckpointError::Checksum(name));
+        }
         let (body, sum) = bytes.split_at(bytes.len() - 8);
         if checksum(body).to_le_bytes() != sum {
             return Err(CheckpointError::Checksum(name));
@@ -260,9 +264,11 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
     // Disks and polygons; a spheropolygon section at the end sets the sweeps.
     p.sweep = vec![0.0; n];
     let cap = d.u64().map_err(corrupt)? as usize;
+    // Grown as read, not reserved: a damaged count must end in an error at the data's
+    // end, not in "capacity overflow" or an abort (issue 16; tests/hostile.rs).
     let mut springs = SpringTable {
-        keys: Vec::with_capacity(cap),
-        values: Vec::with_capacity(cap),
+        keys: Vec::new(),
+        values: Vec::new(),
         sub: Default::default(),
     };
     for _ in 0..cap {

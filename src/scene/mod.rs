@@ -70,6 +70,21 @@ pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
 /// Strict typed parse of a JSON value; errors carry the key path. An array where the
 /// scene has an object is refused (`strict::objects_are_objects`).
 pub fn from_value(value: serde_json::Value) -> Result<Scene, SceneError> {
+    // serde would read a list as the scene's fields in order and name only an index
+    // ("[0]: invalid type: map, expected a string"; issue 16, the fuzz in tests/hostile.rs).
+    if !value.is_object() {
+        let got = match value {
+            serde_json::Value::Array(_) => "an array",
+            serde_json::Value::String(_) => "a string",
+            serde_json::Value::Number(_) => "a number",
+            serde_json::Value::Bool(_) => "a boolean",
+            _ => "null",
+        };
+        return Err(SceneError::invalid(
+            "scene",
+            format!("expected an object with named keys, got {got}"),
+        ));
+    }
     let scene = typed(&value)?;
     let back = serde_json::to_value(&scene).expect("a scene always serialises");
     strict::objects_are_objects(&value, &back, "")?;

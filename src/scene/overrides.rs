@@ -13,6 +13,14 @@ pub fn apply_override(root: &mut Value, assignment: &str) -> Result<(), SceneErr
         SceneError::invalid(assignment, "an override must have the form path=value")
     })?;
     let path = path.trim();
+    if path.is_empty() {
+        // Named by the whole assignment: an empty path would make the message start
+        // with a bare `:`.
+        return Err(SceneError::invalid(
+            assignment,
+            "an override needs a key path before `=`",
+        ));
+    }
     let segments = split_path(path)?;
     let value: Value =
         serde_json::from_str(raw.trim()).unwrap_or_else(|_| Value::String(raw.trim().into()));
@@ -119,5 +127,7 @@ mod tests {
         assert!(apply_override(&mut v, "particles[3].rate=1").is_err());
         assert!(apply_override(&mut v, "no_equals_sign").is_err());
         assert!(apply_override(&mut v, "particles[x]=1").is_err());
+        let e = apply_override(&mut v, " =1").unwrap_err().to_string();
+        assert!(e.starts_with(" =1: an override needs a key path"), "{e}");
     }
 }

@@ -423,6 +423,10 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
             "must be [min, max] with min < max",
         ));
     }
+    // Corner counts before the estimates below, which build a layered block's polygons
+    // (issue 16: `corners` 4294967295 aborted on allocation, 7·10⁶ hung; found by the
+    // fuzz in tests/hostile.rs).
+    polygons(scene)?;
     // Counts before anything is allocated (issue 16: a `bottom_row` of 200 000 hung, a
     // `count` of 4·10⁹ aborted on allocation).
     let limit = scene.limits.max_particles;
@@ -586,7 +590,6 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
             }
         }
     }
-    polygons(scene)?;
     let o = &scene.output;
     finite_non_negative("output.snapshot_every", o.snapshot_every)?;
     if let Some(c) = o.checkpoint_every {

@@ -5,6 +5,7 @@ use serde_json::{Value, json};
 use talus::scene::{self, Scene};
 use talus::sim::Simulation;
 
+pub mod mutate;
 pub mod pairs;
 pub mod wgsl;
 
