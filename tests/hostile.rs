@@ -326,6 +326,13 @@ fn what_the_fuzz_found_stays_fixed() {
         .unwrap_err()
         .to_string();
     assert_eq!(e, "=1: an override needs a key path before `=`");
+    // Ends that are finite but a width that is not: refused rather than run.
+    for ends in ["[-1e308,1e308]", "[-1.7e308,1.7e308]"] {
+        let e = scene::parse(scene::DEFAULT_SCENE, &[format!("domain.x={ends}")])
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("domain.x: must be [min, max]"), "{e}");
+    }
 }
 
 // ---------------------------------------------------------------------------------------
@@ -745,18 +752,10 @@ fn a_killed_run_leaves_whole_files_and_resumes_bitwise() {
         "the runs were killed midway ({kills} of 3); make the scene longer"
     );
 
-    // Bitwise the same end: the final snapshot, the last checkpoint, the energy log.
-    // TODO(run): src/run.rs writes log.csv after the checkpoint, so a kill between the two
-    // leaves the log behind the newest checkpoint, and the resume from it keeps only the
-    // log's rows up to its start: the rows between the two checkpoints are lost. Once the
-    // log is written first (at the end of the run too), assert `!log_behind` and always
-    // compare log.csv; until then it is compared only when no kill landed there.
-    let files: &[&str] = if log_behind {
-        eprintln!("a kill left log.csv behind its checkpoint: log.csv not compared (TODO(run))");
-        &["final.bin", "final.json"]
-    } else {
-        &["final.bin", "final.json", "log.csv"]
-    };
+    // Bitwise the same end: the final snapshot, the last checkpoint, the energy log. The
+    // log is saved before every checkpoint, so no kill leaves it behind the newest one.
+    assert!(!log_behind, "a kill left log.csv behind its newest checkpoint");
+    let files = ["final.bin", "final.json", "log.csv"];
     for f in files {
         let (a, b) = (
             std::fs::read(whole.join(f)).unwrap(),
@@ -768,6 +767,9 @@ fn a_killed_run_leaves_whole_files_and_resumes_bitwise() {
         );
     }
     let (a, b) = (checkpoints_in(&whole), checkpoints_in(&killed));
+    // Resumed three times, the folder still keeps only the newest three checkpoints.
+    assert_eq!(a.len(), 3, "checkpoints kept by the whole run: {a:?}");
+    assert_eq!(b.len(), 3, "checkpoints kept by the resumed runs: {b:?}");
     assert_eq!(
         a.last().and_then(|p| step_of(p)),
         b.last().and_then(|p| step_of(p))

@@ -43,17 +43,32 @@ impl Failure {
     fn new(code: u8, message: impl Display) -> Self {
         Failure {
             code,
-            message: message.to_string(),
+            message: printable(&message.to_string()),
         }
     }
 
     /// The same failure, saying what failed first.
     pub fn within(self, what: impl Display) -> Self {
         Failure {
-            message: format!("{what}: {}", self.message),
+            message: format!("{}: {}", printable(&what.to_string()), self.message),
             ..self
         }
     }
+}
+
+/// The message with control characters other than newlines and tabs escaped, so that a
+/// key or file name echoed from hostile input cannot drive the terminal (issue 16: a key
+/// holding `\u{1b}[31m` coloured the error red).
+fn printable(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    for c in message.chars() {
+        if c.is_control() && c != '\n' && c != '\t' {
+            out.extend(c.escape_unicode());
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 impl From<SceneError> for Failure {
@@ -112,5 +127,18 @@ impl From<RunError> for Failure {
             _ => FAILED,
         };
         Self::new(code, e)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn control_characters_in_a_message_are_escaped() {
+        let f = Failure::input("unknown field `a\u{7}\u{1b}[31mb`\n\tsee docs");
+        assert_eq!(f.message, "unknown field `a\\u{7}\\u{1b}[31mb`\n\tsee docs");
+        let f = Failure::failed("x").within("in \u{9b}file");
+        assert_eq!(f.message, "in \\u{9b}file: x");
     }
 }

@@ -87,11 +87,7 @@ impl Outputs {
                 scene: serde_json::to_value(scene).expect("a scene always serialises"),
                 entries: Vec::new(),
             },
-            checkpoints: Checkpoints {
-                every: checkpoints,
-                dir: out.join("checkpoints"),
-                written: Vec::new(),
-            },
+            checkpoints: Checkpoints::new(checkpoints, out.join("checkpoints"), start_step),
         }
     }
 
@@ -139,14 +135,17 @@ impl Outputs {
         Ok(())
     }
 
-    /// At the end: the last step's checkpoint (unless written already) and the log.
+    /// At the end: the log, then the last step's checkpoint (unless written already).
+    /// The log goes first, as at every checkpoint, so that a kill between the two never
+    /// leaves the newest checkpoint ahead of the log a resume from it continues.
     pub fn write_end(&mut self, engine: &mut Engine) -> Result<(), RunError> {
+        self.log.save()?;
         let last = format!("ckpt_{:010}.bin", engine.step());
         let c = &mut self.checkpoints;
         if c.every != Schedule::NEVER && c.last().is_none_or(|p| !p.ends_with(&last)) {
             c.write(engine)?;
         }
-        self.log.save()
+        Ok(())
     }
 }
 
@@ -305,6 +304,22 @@ pub struct Checkpoints {
 }
 
 impl Checkpoints {
+    /// A resumed run (`start_step` > 0) counts the folder's checkpoints up to its start
+    /// (those past it were removed by `folder::claim`) among the ones it keeps, so that a
+    /// run resumed again and again still keeps only the newest `KEEP_CHECKPOINTS`.
+    fn new(every: Schedule, dir: PathBuf, start_step: u64) -> Self {
+        let mut written = Vec::new();
+        if start_step > 0
+            && let Ok(entries) = std::fs::read_dir(&dir)
+        {
+            written = (entries.flatten().map(|e| e.path()))
+                .filter(|p| checkpoint_step(p).is_some_and(|s| s <= start_step))
+                .collect();
+            written.sort();
+        }
+        Checkpoints { every, dir, written }
+    }
+
     fn last(&self) -> Option<&Path> {
         self.written.last().map(PathBuf::as_path)
     }
@@ -328,6 +343,13 @@ impl Output for Checkpoints {
         }
         Ok(())
     }
+}
+
+/// The step of `ckpt_SSSSSSSSSS.bin`.
+fn checkpoint_step(path: &Path) -> Option<u64> {
+    let name = path.file_name()?.to_str()?;
+    let digits = name.strip_prefix("ckpt_")?.strip_suffix(".bin")?;
+    (digits.len() == 10).then(|| digits.parse().ok())?
 }
 
 /// The settling rules of `stop`, checked every `stop.check_every` (else every step).

@@ -411,16 +411,18 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
         return Err(SceneError::invalid("gravity.g", "must be finite"));
     }
     let d = &scene.domain;
-    if !(d.x[0] < d.x[1] && d.x.iter().all(|v| v.is_finite())) {
+    // The width too must be finite (issue 16: [-1e308, 1e308] overflowed to infinity).
+    if !(d.x[0] < d.x[1] && (d.x[1] - d.x[0]).is_finite()) {
         return Err(SceneError::invalid(
             "domain.x",
-            "must be [min, max] with min < max",
+            "must be [min, max] with min < max and a finite width",
         ));
     }
-    if !(d.z[0] < d.z[1] && d.z.iter().all(|v| v.is_finite())) {
+    // The width too must be finite (issue 16: [-1e308, 1e308] overflowed to infinity).
+    if !(d.z[0] < d.z[1] && (d.z[1] - d.z[0]).is_finite()) {
         return Err(SceneError::invalid(
             "domain.z",
-            "must be [min, max] with min < max",
+            "must be [min, max] with min < max and a finite width",
         ));
     }
     // Corner counts before the estimates below, which build a layered block's polygons
@@ -569,6 +571,12 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                     ((s.base_width - d) * s.slope.to_radians().tan() / (2.0 * h)).floor() + 1.0;
                 let built = s.start_time + (rows - 1.0) * s.interval;
                 if scene.stop.time < built {
+                    // In exponent form when huge (a `row_height` of 1e-300 asks for 10³⁰⁰ rows).
+                    let (rows, built) = if rows < 1e9 {
+                        (format!("{rows}"), format!("{built}"))
+                    } else {
+                        (format!("{rows:.3e}"), format!("{built:.3e}"))
+                    };
                     warnings.push(format!(
                         "particles[{k}]: stop.time = {} ends the run before the layered pile is built: its outline needs at least {rows} rows, one every {} (the last at t = {built})",
                         scene.stop.time, s.interval
