@@ -14,6 +14,8 @@ macro_rules! out {
 }
 #[path = "cli/failure.rs"]
 mod failure;
+#[path = "cli/sweep.rs"]
+mod sweep;
 
 use failure::Failure;
 use std::path::PathBuf;
@@ -153,6 +155,10 @@ enum Command {
         #[arg(long, short)]
         quiet: bool,
     },
+    /// Run a scene for every combination of seeds and parameter values (one folder
+    /// each, J at a time here or as a Slurm job array), measure every run, and collect
+    /// the statistics over seeds (`sweep collect`).
+    Sweep(sweep::SweepArgs),
     /// Measure particle-steps per second per backend and workload; prints JSON.
     Bench {
         /// Backends to measure (auto: the GPU path on a hardware adapter, none on a
@@ -205,10 +211,10 @@ pub fn main() -> ExitCode {
             return ExitCode::from(failure::FAILED);
         }
     };
-    pool.install(|| command(cli.command))
+    pool.install(|| command(cli.command, threads))
 }
 
-fn command(command: Command) -> ExitCode {
+fn command(command: Command, threads: usize) -> ExitCode {
     let result = match command {
         Command::Run {
             scene,
@@ -255,6 +261,7 @@ fn command(command: Command) -> ExitCode {
             backend,
             quiet,
         } => cmd_reproduce(&id, full, only.as_deref(), reuse, out, backend, quiet),
+        Command::Sweep(args) => sweep::cmd_sweep(args, threads),
         Command::Bench {
             backend,
             sizes,
@@ -285,6 +292,16 @@ fn command(command: Command) -> ExitCode {
 /// Loads and validates a scene (the default one when no path is given), prints its
 /// warnings, and builds the initial state.
 fn build_simulation(path: &Option<PathBuf>, overrides: &[String]) -> Result<Simulation, Failure> {
+    let name = path
+        .as_ref()
+        .map_or("default scene".to_string(), |p| p.display().to_string());
+    let scene = load_scene(path, overrides)?;
+    Simulation::new(scene).map_err(|e| Failure::from(e).within(format!("in {name}")))
+}
+
+/// Loads and validates a scene (the default one when no path is given) and prints its
+/// warnings.
+fn load_scene(path: &Option<PathBuf>, overrides: &[String]) -> Result<scene::Scene, Failure> {
     let loaded = match path {
         Some(p) => scene::load(p, overrides),
         None => scene::parse(scene::DEFAULT_SCENE, overrides),
@@ -297,7 +314,7 @@ fn build_simulation(path: &Option<PathBuf>, overrides: &[String]) -> Result<Simu
     for w in scene::warnings(&scene) {
         eprintln!("warning: {w}");
     }
-    Simulation::new(scene).map_err(within)
+    Ok(scene)
 }
 
 /// Where results of a run folder or snapshot go by default: `NAME/` in the run folder,
@@ -516,6 +533,7 @@ fn cmd_reproduce(
                 force: true,
                 resumed_from: None,
                 interrupt: interrupt.clone(),
+                ..Default::default()
             },
         ) {
             if let run::RunError::Interrupted { .. } = e {
@@ -710,6 +728,7 @@ fn cmd_run(
             force,
             resumed_from: resume,
             interrupt: interrupt.clone(),
+            ..Default::default()
         },
     )?;
     if !quiet {

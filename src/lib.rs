@@ -35,4 +35,5 @@ pub mod snapshot;
 pub mod spheropolygon;
 pub mod springs;
 pub mod state;
+pub mod sweep;
 pub mod team;

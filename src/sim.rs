@@ -284,8 +284,14 @@ impl Simulation {
         let (list, kicks) = (&self.neighbours, &self.candidates.kicks);
         let watch = SurveyWatch::new(list, &self.ids, &self.particles, &self.scene);
         let p = &mut self.particles;
-        let (q, active, fixed, mass, inertia, radius) =
-            (&mut p.q, &mut p.active, &p.fixed, &p.mass, &p.inertia, &p.radius);
+        let (q, active, fixed, mass, inertia, radius) = (
+            &mut p.q,
+            &mut p.active,
+            &p.fixed,
+            &p.mass,
+            &p.inertia,
+            &p.radius,
+        );
         crate::parallel::for_each6_with2(q, &mut self.velocity, active, |i, v, velocity, on| {
             let [q0, q1, q2, q3, q4, q5] = v;
             let integrated = *on && !fixed[i];
@@ -544,7 +550,11 @@ impl Simulation {
         let name = |p: Pair| {
             let ids = id_pair(p, &self.ids);
             if p.is_wall() {
-                format!("particle {} and wall {}", ids.i, p.j - crate::contacts::WALL_BASE)
+                format!(
+                    "particle {} and wall {}",
+                    ids.i,
+                    p.j - crate::contacts::WALL_BASE
+                )
             } else {
                 format!("particles {} and {}", ids.i, ids.j)
             }

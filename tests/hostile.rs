@@ -754,7 +754,10 @@ fn a_killed_run_leaves_whole_files_and_resumes_bitwise() {
 
     // Bitwise the same end: the final snapshot, the last checkpoint, the energy log. The
     // log is saved before every checkpoint, so no kill leaves it behind the newest one.
-    assert!(!log_behind, "a kill left log.csv behind its newest checkpoint");
+    assert!(
+        !log_behind,
+        "a kill left log.csv behind its newest checkpoint"
+    );
     let files = ["final.bin", "final.json", "log.csv"];
     for f in files {
         let (a, b) = (

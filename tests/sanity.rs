@@ -31,7 +31,9 @@ fn particles_placed_into_each_other_are_bad_input_with_their_ids() {
         { "position": [0.8, 0.0], "diameter": 1.0 },
         { "position": [5.0, 0.0], "diameter": 1.0 }
     ]));
-    let e = build(&v, &[]).err().expect("deep initial overlaps are refused");
+    let e = build(&v, &[])
+        .err()
+        .expect("deep initial overlaps are refused");
     assert!(
         e.contains("limits.initial_overlap") && e.contains("particles 0 and 1 by 0.400"),
         "{e}"
@@ -53,7 +55,9 @@ fn a_particle_placed_into_a_wall_is_named_with_the_wall() {
         { "position": [0.0, 0.3], "diameter": 1.0 }
     ]));
     v["walls"] = json!([{ "from": [-5.0, 0.0], "to": [5.0, 0.0] }]);
-    let e = build(&v, &[]).err().expect("a disk 0.2 into a wall is refused");
+    let e = build(&v, &[])
+        .err()
+        .expect("a disk 0.2 into a wall is refused");
     assert!(e.contains("particle 1 and wall 0 by 0.400"), "{e}");
 }
 
@@ -134,8 +138,13 @@ fn a_source_whose_outlet_reaches_beyond_the_domain_is_named() {
         "kind": "point_source", "material": "m", "position": [90.0, 50.0],
         "spread": 20.0, "rate": 10.0, "count": 10, "diameter": 1.0
     }]);
-    let e = build(&v, &[]).err().expect("an outlet reaching x = 110 is refused");
-    assert!(e.contains("particles[0].spread") && e.contains("(110, 50)"), "{e}");
+    let e = build(&v, &[])
+        .err()
+        .expect("an outlet reaching x = 110 is refused");
+    assert!(
+        e.contains("particles[0].spread") && e.contains("(110, 50)"),
+        "{e}"
+    );
     v["particles"][0]["spread"] = json!(5.0);
     assert!(build(&v, &[]).is_ok());
 }

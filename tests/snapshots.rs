@@ -113,8 +113,14 @@ fn a_snapshot_without_its_checksum_or_pointing_elsewhere_is_refused() {
     // The data must lie beside the metadata.
     for data in ["../snap.bin", "/dev/zero"] {
         let e = rewrite(&|m| m["data"] = json!(data));
-        assert!(matches!(e, Err(SnapshotError::NotASnapshot(_))), "{data}: {e:?}");
+        assert!(
+            matches!(e, Err(SnapshotError::NotASnapshot(_))),
+            "{data}: {e:?}"
+        );
     }
     let newer = rewrite(&|m| m["version"] = json!(99));
-    assert!(matches!(newer, Err(SnapshotError::Newer { .. })), "{newer:?}");
+    assert!(
+        matches!(newer, Err(SnapshotError::Newer { .. })),
+        "{newer:?}"
+    );
 }

@@ -12,6 +12,7 @@ use talus::render::RenderError;
 use talus::reproduce::UnknownReproduction;
 use talus::run::RunError;
 use talus::scene::SceneError;
+use talus::sweep::SweepError;
 
 pub const INPUT: u8 = 2;
 pub const FAILED: u8 = 1;
@@ -115,6 +116,17 @@ impl From<GpuError> for Failure {
 impl From<BenchError> for Failure {
     fn from(e: BenchError) -> Self {
         Self::new(FAILED, e)
+    }
+}
+
+/// A sweep's arguments, plan and folder are input; writing its files is not.
+impl From<SweepError> for Failure {
+    fn from(e: SweepError) -> Self {
+        let code = match e {
+            SweepError::Io { .. } => FAILED,
+            _ => INPUT,
+        };
+        Self::new(code, e)
     }
 }
 

@@ -179,7 +179,10 @@ impl Gpu {
 
     /// The first failure the device reported, if any.
     pub fn failure(&self) -> Option<String> {
-        self.failure.lock().unwrap_or_else(|p| p.into_inner()).clone()
+        self.failure
+            .lock()
+            .unwrap_or_else(|p| p.into_inner())
+            .clone()
     }
 
     /// Checks a buffer of `bytes` against the device limits before allocating it.

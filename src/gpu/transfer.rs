@@ -394,7 +394,6 @@ impl MapFlag {
 }
 
 impl GpuSimulation {
-
     pub(super) fn write_buffer<T: bytemuck::Pod>(&mut self, buf: &wgpu::Buffer, data: &[T]) {
         self.gpu
             .queue

@@ -11,6 +11,24 @@ use std::path::{Path, PathBuf};
 
 type Series<'a> = (&'a str, RGBColor, Vec<(f64, f64)>);
 
+/// A named series of (x, mean, standard deviation) for `write_bands`.
+pub type Means = (String, Vec<(f64, f64, f64)>);
+
+/// Colours of the series of a plot, in order.
+const PALETTE: [RGBColor; 8] = [
+    BLUE,
+    RED,
+    RGBColor(0, 140, 0),
+    MAGENTA,
+    BLACK,
+    RGBColor(230, 140, 0),
+    CYAN,
+    RGBColor(120, 120, 120),
+];
+
+/// A shaded band (x, low, high) under a series of the same colour.
+type Band = (RGBColor, Vec<(f64, f64, f64)>);
+
 /// One line plot; `series` share the axes.
 fn plot(
     path: &Path,
@@ -19,9 +37,23 @@ fn plot(
     y_label: &str,
     series: &[Series],
 ) -> Result<(), RenderError> {
-    let pts = series
-        .iter()
-        .flat_map(|s| s.2.iter())
+    plot_with_bands(path, title, x_label, y_label, series, &[])
+}
+
+/// One line plot with shaded bands (drawn first, under the lines).
+fn plot_with_bands(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[Series],
+    bands: &[Band],
+) -> Result<(), RenderError> {
+    let band_points = (bands.iter().flat_map(|b| b.1.iter()))
+        .flat_map(|&(x, lo, hi)| [(x, lo), (x, hi)])
+        .collect::<Vec<_>>();
+    let pts = (series.iter().flat_map(|s| s.2.iter()))
+        .chain(band_points.iter())
         .filter(|p| p.0.is_finite() && p.1.is_finite());
     let (mut x0, mut x1, mut y0, mut y1) =
         (f64::INFINITY, f64::NEG_INFINITY, 0.0f64, f64::NEG_INFINITY);
@@ -61,6 +93,19 @@ fn plot(
             .y_desc(y_label)
             .draw()
             .map_err(|x| e(&x))?;
+        for (color, band) in bands {
+            // The band's outline: along the upper edge, back along the lower one.
+            let finite =
+                |p: &&(f64, f64, f64)| p.0.is_finite() && p.1.is_finite() && p.2.is_finite();
+            let edge: Vec<(f64, f64)> = (band.iter().filter(finite).map(|p| (p.0, p.2)))
+                .chain(band.iter().rev().filter(finite).map(|p| (p.0, p.1)))
+                .collect();
+            if edge.len() >= 3 {
+                chart
+                    .draw_series(std::iter::once(Polygon::new(edge, color.mix(0.2).filled())))
+                    .map_err(|x| e(&x))?;
+            }
+        }
         for (name, color, data) in series {
             let c = *color;
             chart
@@ -185,16 +230,6 @@ pub fn write_profiles(
     title: &str,
     profiles: &[(String, Vec<(f64, f64)>)],
 ) -> Result<(), RenderError> {
-    const PALETTE: [RGBColor; 8] = [
-        BLUE,
-        RED,
-        RGBColor(0, 140, 0),
-        MAGENTA,
-        BLACK,
-        RGBColor(230, 140, 0),
-        CYAN,
-        RGBColor(120, 120, 120),
-    ];
     let series: Vec<Series> = profiles
         .iter()
         .enumerate()
@@ -207,4 +242,30 @@ pub fn write_profiles(
         "S_zz(1) = 2 sigma_zz / (rho g h)",
         &series,
     )
+}
+
+/// Means with a band of ± one standard deviation, one colour per named series
+/// (`talus sweep collect`: the seed average of each grid point). A point is
+/// (x, mean, standard deviation); an undefined deviation (one seed) draws no band there.
+pub fn write_bands(
+    path: &Path,
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    means: &[Means],
+) -> Result<(), RenderError> {
+    let colour = |k: usize| PALETTE[k % PALETTE.len()];
+    let series: Vec<Series> = (means.iter().enumerate())
+        .map(|(k, (name, data))| {
+            let line = data.iter().map(|p| (p.0, p.1)).collect();
+            (name.as_str(), colour(k), line)
+        })
+        .collect();
+    let bands: Vec<Band> = (means.iter().enumerate())
+        .map(|(k, (_, data))| {
+            let band = data.iter().map(|p| (p.0, p.1 - p.2, p.1 + p.2)).collect();
+            (colour(k), band)
+        })
+        .collect();
+    plot_with_bands(path, title, x_label, y_label, &series, &bands)
 }

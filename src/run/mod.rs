@@ -19,7 +19,7 @@ use outputs::{Outputs, Schedule, Settling};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 #[derive(Clone, Debug, Default)]
@@ -32,6 +32,9 @@ pub struct RunOptions {
     pub resumed_from: Option<PathBuf>,
     /// Set (by a signal handler) to stop the run between two advances.
     pub interrupt: Arc<AtomicBool>,
+    /// The run's step, updated as its progress is (for a caller showing the progress of
+    /// several runs, as `talus sweep` does).
+    pub step: Arc<AtomicU64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -214,6 +217,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
         particle_steps += active * (next - now);
         let step = next;
         outputs.write_due(engine)?;
+        opts.step.store(step, Ordering::Relaxed);
         if settling.every.due(step) {
             progress.update(step, time(step), engine.active_count() as usize);
             if settling.settled(engine, time(step), &progress)? {

@@ -317,7 +317,11 @@ impl Checkpoints {
                 .collect();
             written.sort();
         }
-        Checkpoints { every, dir, written }
+        Checkpoints {
+            every,
+            dir,
+            written,
+        }
     }
 
     fn last(&self) -> Option<&Path> {

@@ -534,7 +534,11 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 // The outlet's whole width: a particle drawn beyond the domain would be
                 // lost as it appears.
                 for side in [-1.0, 1.0] {
-                    inside(scene, &at("spread"), [s.position[0] + side * s.spread, s.position[1]])?;
+                    inside(
+                        scene,
+                        &at("spread"),
+                        [s.position[0] + side * s.spread, s.position[1]],
+                    )?;
                 }
                 finite_positive(&at("rate"), s.rate)?;
                 finite_non_negative(&at("start_time"), s.start_time)?;
