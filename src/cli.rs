@@ -144,8 +144,16 @@ enum Command {
         only: Option<String>,
         /// Keep the variants whose folder already holds a finished run of the same
         /// scene: measure and draw them again without running them.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "seeds")]
         reuse: bool,
+        /// Run every variant for these seeds (A..B, both included, or A,B,C) as a sweep
+        /// (`talus sweep`): each variant's folder is a sweep folder, and reproduce.json
+        /// gets the mean, spread and standard error over seeds. Run again, it continues.
+        #[arg(long, value_name = "A..B")]
+        seeds: Option<String>,
+        /// With --seeds: runs at once (default: one per core).
+        #[arg(long, requires = "seeds")]
+        jobs: Option<usize>,
         /// Output folder (default: runs/reproduce/ID).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -256,10 +264,30 @@ fn command(command: Command, threads: usize) -> ExitCode {
             id,
             full,
             only,
-            reuse,
+            reuse: _,
+            seeds: Some(seeds),
+            jobs,
             out,
             backend,
             quiet,
+        } => {
+            let seeds = sweep::Seeds {
+                seeds,
+                jobs,
+                threads,
+            };
+            sweep::reproduce(&id, full, only.as_deref(), &seeds, out, backend, quiet)
+        }
+        Command::Reproduce {
+            id,
+            full,
+            only,
+            reuse,
+            seeds: None,
+            out,
+            backend,
+            quiet,
+            ..
         } => cmd_reproduce(&id, full, only.as_deref(), reuse, out, backend, quiet),
         Command::Sweep(args) => sweep::cmd_sweep(args, threads),
         Command::Bench {
@@ -470,6 +498,26 @@ fn finished_run_of(dir: &std::path::Path, scene: &scene::Scene) -> bool {
         && read("scene.json").is_some_and(|s| serde_json::to_value(scene).ok() == Some(s))
 }
 
+/// The variants of reproduction `id`, those whose name contains `only` if given.
+fn chosen_variants(
+    id: &str,
+    full: bool,
+    only: Option<&str>,
+) -> Result<Vec<talus::reproduce::Variant>, Failure> {
+    let mut variants = talus::reproduce::variants(id, full)?;
+    if let Some(only) = only {
+        let names: Vec<String> = variants.iter().map(|v| v.name.clone()).collect();
+        variants.retain(|v| v.name.contains(only));
+        if variants.is_empty() {
+            return Err(Failure::input(format!(
+                "--only {only}: no variant of {id} matches; they are {}",
+                names.join(", ")
+            )));
+        }
+    }
+    Ok(variants)
+}
+
 fn cmd_reproduce(
     id: &str,
     full: bool,
@@ -481,17 +529,7 @@ fn cmd_reproduce(
 ) -> Result<(), Failure> {
     use talus::reproduce;
     let id = id.to_uppercase();
-    let mut variants = reproduce::variants(&id, full)?;
-    if let Some(only) = only {
-        let names: Vec<String> = variants.iter().map(|v| v.name.clone()).collect();
-        variants.retain(|v| v.name.contains(only));
-        if variants.is_empty() {
-            return Err(Failure::input(format!(
-                "--only {only}: no variant of {id} matches; they are {}",
-                names.join(", ")
-            )));
-        }
-    }
+    let variants = chosen_variants(&id, full, only)?;
     let root = out.unwrap_or_else(|| PathBuf::from("runs/reproduce").join(&id));
     let interrupt = on_interrupt();
     let mut found = Vec::new();

@@ -174,8 +174,30 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproductio
                     14.0,
                     1.0,
                 ),
-                // The short tail is four times as steep: a quarter of the step.
+                // The stiffness paper 001's Fig. 5 states, k = 500 m g/σ, beside the one
+                // eq. 14 gives from the continuous run's closest approach (188 m g/σ).
+                v(
+                    "hooke-k500",
+                    base,
+                    &[
+                        "contact.law=hooke_equivalent",
+                        "contact.k=500",
+                        "limits.max_overlap=0.95",
+                    ],
+                    14.0,
+                    1.0,
+                ),
+                // The short tail is four times as steep: a quarter of the step. With R4's
+                // long tail (r0 = 1.2σ), and with the short tail r0 = 1.047σ the paper's
+                // "M profile lost" is about (Fig. 6a/7a).
                 v("n144", base, &["contact.n=144", "dt=0.00025"], 14.0, 1.0),
+                v(
+                    "n144-short",
+                    base,
+                    &["contact.n=144", "contact.r0=1.047", "dt=0.00025"],
+                    14.0,
+                    1.0,
+                ),
                 // δ % polydispersity: diameters uniform in [(1 − δ) σ, σ] (paper 001
                 // sec. II).
                 v(

@@ -402,3 +402,54 @@ fn bad_sweeps_are_refused_and_another_sweeps_folder_too() {
     assert_eq!(names, ["0000-seed3"]);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn reproduce_with_seeds_runs_each_variant_as_a_sweep() {
+    let dir = scratch("reproduce");
+    let out = dir.to_str().unwrap();
+    let args = [
+        "reproduce",
+        "R1",
+        "--seeds",
+        "1..2",
+        "--only",
+        "nu1.5",
+        "--backend",
+        "cpu",
+        "--out",
+        out,
+        "-q",
+    ];
+    let o = run(2, &args);
+    assert!(o.status.success(), "{}", text(&o));
+    let report: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("reproduce.json")).unwrap())
+            .unwrap();
+    let v = &report["variants"][0];
+    assert_eq!(v["variant"], "pile-nu1.5");
+    assert_eq!(v["measured"], 2);
+    // A lattice pile without size disorder does not depend on the seed: both runs are the
+    // same heap, so the spread over seeds is exactly zero.
+    let repose = &v["statistics"]["repose_left_deg"];
+    assert_eq!(repose["n"], 2);
+    assert_eq!(repose["std"], 0.0, "{repose}");
+    assert!(
+        (25.0..35.0).contains(&repose["mean"].as_f64().unwrap()),
+        "{repose}"
+    );
+    assert!(dir.join("pile-nu1.5/collect/points.csv").is_file());
+    assert!(
+        std::fs::read_to_string(dir.join("profiles.svg"))
+            .unwrap()
+            .contains("<polygon")
+    );
+    // Run again, it continues: nothing is run twice.
+    let o = run(2, &args);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("2 measured already, 0 to do"),
+        "{}",
+        text(&o)
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
