@@ -118,6 +118,12 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
             e.bytes.extend_from_slice(raw);
         }
     }
+    // Copies of the scene (`replicas`), only when there are some: a tag and each
+    // particle's copy.
+    if p.copy.iter().any(|&c| c != 0) {
+        e.u8(REPLICAS);
+        p.copy.iter().for_each(|&c| e.u32(c));
+    }
     // A checksum of everything before it (issue 16: of 30 random one-byte flips none was
     // noticed and 9 resumed into another result).
     let sum = checksum(&e.bytes);
@@ -129,8 +135,10 @@ fn checksum(bytes: &[u8]) -> u64 {
     crate::files::fnv1a64(crate::files::FNV_START, bytes)
 }
 
-/// The tag of the spheropolygon section at a checkpoint's end.
+/// The tags of the optional sections at a checkpoint's end, in this order: the
+/// spheropolygons', then the copies'.
 const SWEPT: u8 = 1;
+const REPLICAS: u8 = 2;
 
 pub fn write(sim: &Simulation, device: Option<&DeviceState>, path: &Path) -> std::io::Result<()> {
     write_atomic(path, &encode(sim, device))
@@ -261,8 +269,9 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
         }
         p.shape.push(corners);
     }
-    // Disks and polygons; a spheropolygon section at the end sets the sweeps.
+    // Disks and polygons of one copy; the sections at the end set sweeps and copies.
     p.sweep = vec![0.0; n];
+    p.copy = vec![0; n];
     let cap = d.u64().map_err(corrupt)? as usize;
     // Grown as read, not reserved: a damaged count must end in an error at the data's
     // end, not in "capacity overflow" or an abort (issue 16; tests/hostile.rs).
@@ -306,12 +315,14 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
     } else {
         None
     };
-    if !d.is_done() {
+    let damaged = || corrupt(crate::files::DecodeError(bytes.len()));
+    let mut tag = if d.is_done() {
+        None
+    } else {
+        Some(d.u8().map_err(corrupt)?)
+    };
+    if tag == Some(SWEPT) {
         // The spheropolygon section (`encode`).
-        let damaged = || corrupt(crate::files::DecodeError(bytes.len()));
-        if d.u8().map_err(corrupt)? != SWEPT {
-            return Err(damaged());
-        }
         p.sweep = (0..n)
             .map(|_| d.f64())
             .collect::<Result<_, _>>()
@@ -342,8 +353,23 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
             }
             ds.sub = bytemuck::pod_collect_to_vec(raw);
         }
+        tag = if d.is_done() {
+            None
+        } else {
+            Some(d.u8().map_err(corrupt)?)
+        };
     }
-    if !d.is_done() || !cap.is_power_of_two() {
+    if tag == Some(REPLICAS) {
+        p.copy = (0..n)
+            .map(|_| d.u32())
+            .collect::<Result<_, _>>()
+            .map_err(corrupt)?;
+        if p.copy.iter().any(|&c| c >= scene.replicas) {
+            return Err(damaged());
+        }
+        tag = None;
+    }
+    if tag.is_some() || !d.is_done() || !cap.is_power_of_two() {
         return Err(corrupt(crate::files::DecodeError(bytes.len())));
     }
     let sim = Simulation::from_parts(scene, p, springs, sources, rng, step, lost)

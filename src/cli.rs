@@ -789,25 +789,34 @@ fn cmd_run(
         )));
     }
     // The final state's measurements and pictures; a failure here does not undo the run.
-    match measure_and_draw(
-        &out,
-        &out.join("analysis"),
-        &out.join("pictures"),
-        &talus::analyze::Options::default(),
-        None,
-        talus::render::Field::Pressure,
-        1600,
-    ) {
-        Ok(n) if !quiet => eprintln!(
-            "measurements in {}/analysis, pictures in {}/pictures ({n} files)",
-            out.display(),
-            out.display()
-        ),
-        Ok(_) => {}
-        Err(e) => eprintln!(
-            "warning: the final state could not be analysed: {}",
-            e.message
-        ),
+    // With copies of the scene, each copy's (their heaps lie on top of each other in the
+    // whole state).
+    let folders: Vec<PathBuf> = match engine.host().scene.replicas {
+        1 => vec![out.clone()],
+        k => (0..k).map(|c| run::copy_dir(&out, c)).collect(),
+    };
+    for dir in &folders {
+        match measure_and_draw(
+            dir,
+            &dir.join("analysis"),
+            &dir.join("pictures"),
+            &talus::analyze::Options::default(),
+            None,
+            talus::render::Field::Pressure,
+            1600,
+        ) {
+            Ok(n) if !quiet => eprintln!(
+                "measurements in {}/analysis, pictures in {}/pictures ({n} files)",
+                dir.display(),
+                dir.display()
+            ),
+            Ok(_) => {}
+            Err(e) => eprintln!(
+                "warning: the final state of {} could not be analysed: {}",
+                dir.display(),
+                e.message
+            ),
+        }
     }
     Ok(())
 }

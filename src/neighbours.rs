@@ -283,10 +283,11 @@ pub fn cell_order(grid: &Grid, particles: &Particles, ids: &[u32]) -> Vec<u32> {
     order
 }
 
-/// A cell's key: its row, then its column (u64: a domain 10⁵ diameters square has 10¹⁰
-/// cells).
-fn cell_key(grid: &Grid, x: u32, z: u32) -> u64 {
-    z as u64 * grid.nx as u64 + x as u64
+/// A cell's key: its copy of the scene (`replicas`), its row, then its column (u64: a
+/// domain 10⁵ diameters square has 10¹⁰ cells). Copies lie on the same grid but in
+/// separate runs of keys, so that a particle never finds another copy's.
+fn cell_key(grid: &Grid, copy: u32, x: u32, z: u32) -> u64 {
+    (copy as u64 * grid.nz as u64 + z as u64) * grid.nx as u64 + x as u64
 }
 
 /// Every active particle as (cell key, id, slot), sorted: by cell, and by id within a
@@ -297,7 +298,7 @@ fn sort_by_cell(grid: &Grid, particles: &Particles, ids: &[u32], out: &mut Vec<C
     out.extend(
         crate::parallel::map(particles.len(), |i| {
             let (x, z) = grid.cell_coords([q[i][0], q[i][1]]);
-            (cell_key(grid, x, z), ids[i], i as u32)
+            (cell_key(grid, particles.copy[i], x, z), ids[i], i as u32)
         })
         .into_iter()
         .filter(|&(_, _, i)| particles.active[i as usize]),
@@ -308,9 +309,16 @@ fn sort_by_cell(grid: &Grid, particles: &Particles, ids: &[u32], out: &mut Vec<C
 /// A particle of the sparse cell list: (cell key, id, memory slot).
 type Cell = (u64, u32, u32);
 
-/// The particles of the cells x0..=x1 of row z: one run of the sorted list.
-fn row_of_cells<'a>(grid: &Grid, cells: &'a [Cell], x0: u32, x1: u32, z: u32) -> &'a [Cell] {
-    let (lo, hi) = (cell_key(grid, x0, z), cell_key(grid, x1, z));
+/// The particles of copy `copy` in the cells x0..=x1 of row z: one run of the sorted
+/// list.
+fn row_of_cells<'a>(
+    grid: &Grid,
+    cells: &'a [Cell],
+    copy: u32,
+    [x0, x1]: [u32; 2],
+    z: u32,
+) -> &'a [Cell] {
+    let (lo, hi) = (cell_key(grid, copy, x0, z), cell_key(grid, copy, x1, z));
     let a = cells.partition_point(|c| c.0 < lo);
     let b = a + cells[a..].partition_point(|c| c.0 <= hi);
     &cells[a..b]
@@ -357,7 +365,7 @@ fn candidates_of(s: &Search, i: usize, out: &mut Vec<Pair>) {
     let mut found: Vec<(u32, u32)> = Vec::new();
     for z in cz.saturating_sub(1)..=(cz + 1).min(grid.nz - 1) {
         // The three cells x0..=x1 of a row are one run of the sorted list.
-        for &(_, id, j) in row_of_cells(grid, s.cells, x0, x1, z) {
+        for &(_, id, j) in row_of_cells(grid, s.cells, particles.copy[i], [x0, x1], z) {
             let ju = j as usize;
             if id <= s.ids[i] || (particles.fixed[i] && particles.fixed[ju]) {
                 continue;

@@ -128,14 +128,28 @@ pub struct Simulation {
 
 impl Simulation {
     /// Builds the initial state of a validated scene.
+    ///
+    /// With `replicas` K, copy c is the scene made with the seed `seed + c`: its initial
+    /// particles (ids of copy c after those of copy c − 1) and its sources, in the same
+    /// order as a run of that seed alone; the generator kept is copy 0's.
     pub fn new(scene: Scene) -> Result<Self, SceneError> {
+        let mut particles = Particles::default();
+        let mut sources = Vec::new();
         let mut rng = Rng::new(scene.seed);
-        let (particles, starts) = create::initial_particles_by_block(&scene, &mut rng);
-        check_created(&scene, &particles, &starts)?;
-        // Point sources first (the GPU path indexes them so), then layered blocks.
-        let sources = (0..source_count(&scene))
-            .map(|k| SourceState::new(scene.seed, k))
-            .collect();
+        for c in 0..scene.replicas {
+            let seed = copy_seed(&scene, c);
+            let mut copy_rng = Rng::new(seed);
+            let (created, starts) = create::initial_particles_by_block(&scene, &mut copy_rng);
+            check_created(&scene, &created, &starts)?;
+            if c == 0 {
+                particles = created;
+                rng = copy_rng;
+            } else {
+                particles.append(&created, c);
+            }
+            // Point sources first (the GPU path indexes them so), then layered blocks.
+            sources.extend((0..source_count(&scene)).map(|k| SourceState::new(seed, k)));
+        }
         let mut sim =
             Self::from_parts(scene, particles, SpringTable::default(), sources, rng, 0, 0)?;
         sim.start()?;
@@ -154,14 +168,24 @@ impl Simulation {
     ) -> Result<Self, SceneError> {
         let g = scene.gravity.g;
         let law = ContactLaw::from_spec(&scene.contact, (g[0] * g[0] + g[1] * g[1]).sqrt())?;
-        if sources.len() != source_count(&scene) {
+        let copies = scene.replicas as usize;
+        if sources.len() != copies * source_count(&scene) {
             return Err(SceneError::invalid(
                 "particles",
                 format!(
-                    "the state has {} source states for {} point sources and layered blocks",
+                    "the state has {} source states for {} point sources and layered blocks \
+                     in {copies} copies",
                     sources.len(),
                     source_count(&scene)
                 ),
+            ));
+        }
+        if particles.copy.len() != particles.len()
+            || particles.copy.iter().any(|&c| c >= scene.replicas)
+        {
+            return Err(SceneError::invalid(
+                "replicas",
+                format!("the state's particles are not all of its {copies} copies"),
             ));
         }
         let walls = scene
@@ -223,16 +247,12 @@ impl Simulation {
     /// all its rows, and gravity is at full strength.
     pub fn feeding_done(&self) -> bool {
         let (sources, layered) = creators(&self.scene);
-        let p = sources.len();
-        sources
-            .iter()
-            .zip(&self.sources)
-            .all(|(spec, st)| st.done(spec))
-            && layered
-                .iter()
-                .zip(&self.sources[p..])
-                .all(|(spec, st)| st.inserted >= create::layered::max_rows(spec))
-            && self.time() >= self.scene.gravity.ramp_time
+        let (p, n) = (sources.len(), sources.len() + layered.len());
+        (self.sources.chunks(n.max(1))).all(|copy| {
+            (sources.iter().zip(copy)).all(|(spec, st)| st.done(spec))
+                && (layered.iter().zip(&copy[p..]))
+                    .all(|(spec, st)| st.inserted >= create::layered::max_rows(spec))
+        }) && self.time() >= self.scene.gravity.ramp_time
     }
 
     /// The skin of the neighbour list: the scene's, or DEFAULT_SKIN of the largest
@@ -658,44 +678,55 @@ impl Simulation {
     /// Whether a source or layered block tries to insert at time t.
     fn insertion_due(&self, t: f64) -> bool {
         let (sources, layered) = creators(&self.scene);
-        let p = sources.len();
-        let pour = (sources.iter().zip(&self.sources)).any(|(s, st)| create::source::due(s, st, t));
-        pour || (layered.iter().zip(&self.sources[p..]))
-            .any(|(l, st)| create::layered::due(l, st, t))
+        let (p, n) = (sources.len(), sources.len() + layered.len());
+        (self.sources.chunks(n.max(1))).any(|copy| {
+            (sources.iter().zip(copy)).any(|(s, st)| create::source::due(s, st, t))
+                || (layered.iter().zip(&copy[p..])).any(|(l, st)| create::layered::due(l, st, t))
+        })
     }
 
+    /// Each copy's sources and layered blocks in scene order, copy after copy: within a
+    /// copy the particles come in the order of a run of that copy alone.
     fn insert_from_sources(&mut self, t: f64) {
         let (sources, layered) = creators(&self.scene);
+        let n = sources.len() + layered.len();
         let mut new = Vec::new();
-        for (k, spec) in sources.iter().enumerate() {
-            let material = create::material_index(&self.scene, &spec.material);
-            new.extend(create::source::emit(
-                spec,
-                &mut self.sources[k],
-                t,
-                material,
-                &self.particles,
-            ));
-            self.push_new(&mut new, t);
-        }
-        for (m, spec) in layered.iter().enumerate() {
-            let material = create::material_index(&self.scene, &spec.material);
-            let k = sources.len() + m;
-            new.extend(create::layered::emit(
-                spec,
-                &mut self.sources[k],
-                t,
-                material,
-                &self.particles,
-            ));
-            self.push_new(&mut new, t);
+        for c in 0..self.scene.replicas {
+            let first = c as usize * n;
+            for (k, spec) in sources.iter().enumerate() {
+                let material = create::material_index(&self.scene, &spec.material);
+                new.extend(create::source::emit(
+                    spec,
+                    &mut self.sources[first + k],
+                    t,
+                    material,
+                    &self.particles,
+                    c,
+                ));
+                self.push_new(&mut new, t, c);
+            }
+            for (m, spec) in layered.iter().enumerate() {
+                let material = create::material_index(&self.scene, &spec.material);
+                let k = first + sources.len() + m;
+                new.extend(create::layered::emit(
+                    spec,
+                    &mut self.sources[k],
+                    t,
+                    material,
+                    &self.particles,
+                    c,
+                ));
+                self.push_new(&mut new, t, c);
+            }
         }
     }
 
-    /// Adds created particles; Gear starts them with the gravitational acceleration.
-    fn push_new(&mut self, new: &mut Vec<create::NewParticle>, t: f64) {
+    /// Adds created particles of copy `copy`; Gear starts them with the gravitational
+    /// acceleration.
+    fn push_new(&mut self, new: &mut Vec<create::NewParticle>, t: f64, copy: u32) {
         for d in new.drain(..) {
             let id = create::push(&self.scene, &mut self.particles, &d) as usize;
+            self.particles.copy[id] = copy;
             // Ids are never reused: the new one is the number of particles so far.
             self.ids.push(self.ids.len() as u32);
             let h = 0.5 * self.scene.dt * self.scene.dt;
@@ -770,6 +801,51 @@ impl Simulation {
                 self.lost += 1;
             }
         }
+    }
+
+    /// Copy `c` of a scene with `replicas` on its own, as the run of its seed alone
+    /// would hold it at this step: its particles (renumbered in their order), sources,
+    /// the contacts of the last evaluation among them, and the scene with the copy's
+    /// seed. For its energies, snapshots and analysis; it is not stepped (its springs
+    /// stay here).
+    pub fn replica(&self, c: u32) -> Result<Simulation, SceneError> {
+        let (particles, index) = self.particles.of_copy(c);
+        let mut new_id = vec![u32::MAX; self.particles.len()];
+        for (k, &i) in index.iter().enumerate() {
+            new_id[i] = k as u32;
+        }
+        let n = source_count(&self.scene);
+        let sources = self.sources[c as usize * n..(c as usize + 1) * n].to_vec();
+        let mut scene = self.scene.clone();
+        scene.seed = copy_seed(&self.scene, c);
+        scene.replicas = 1;
+        // Only leaving the domain deactivates a particle.
+        let lost = particles.active.iter().filter(|a| !**a).count() as u64;
+        let rng = self.rng.clone();
+        let mut sim = Self::from_parts(
+            scene,
+            particles,
+            SpringTable::default(),
+            sources,
+            rng,
+            self.step,
+            lost,
+        )?;
+        for (p, contact) in self.pairs.iter().zip(&self.contacts) {
+            if self.particles.copy[p.i as usize] == c {
+                let j = if p.is_wall() {
+                    p.j
+                } else {
+                    new_id[p.j as usize]
+                };
+                sim.pairs.push(Pair {
+                    i: new_id[p.i as usize],
+                    j,
+                });
+                sim.contacts.push(*contact);
+            }
+        }
+        Ok(sim)
     }
 
     /// Kinetic, elastic and potential energy now.
@@ -943,6 +1019,11 @@ pub fn creators(scene: &Scene) -> (Vec<crate::scene::PointSource>, Vec<crate::sc
 }
 
 /// How many source states a scene has: its point sources, then its layered blocks.
+/// The seed of copy `c` of a scene (`replicas`): the scene's seed plus c.
+pub fn copy_seed(scene: &Scene, c: u32) -> u64 {
+    scene.seed.wrapping_add(c as u64)
+}
+
 fn source_count(scene: &Scene) -> usize {
     let (s, l) = creators(scene);
     s.len() + l.len()

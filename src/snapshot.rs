@@ -186,6 +186,15 @@ pub fn capture(sim: &Simulation, stem: &str) -> Snapshot {
         len,
         Column::F64(ids.iter().map(|&i| p.sweep[i]).collect()),
     );
+    // Copies of the scene (`replicas`): each particle's copy, only when there are copies.
+    if sim.scene.replicas > 1 {
+        b.push(
+            "particles",
+            "copy",
+            "",
+            Column::U32(ids.iter().map(|&i| p.copy[i]).collect()),
+        );
+    }
     let c = &sim.contacts;
     let pairs = &sim.pairs;
     let cf = |g: &dyn Fn(usize) -> f64| Column::F64((0..c.len()).map(g).collect());

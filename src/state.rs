@@ -31,6 +31,9 @@ pub struct Particles {
     /// A spheropolygon's sweep radius (src/spheropolygon.rs: `shape` is then its core,
     /// two corners for a rod); 0 for disks and polygons.
     pub sweep: Vec<f64>,
+    /// The copy of the scene a particle belongs to (`replicas`; 0 without copies): it
+    /// touches only particles of its own copy.
+    pub copy: Vec<u32>,
 }
 
 /// A new particle before it joins the state.
@@ -100,6 +103,7 @@ impl Particles {
         self.material.push(d.material);
         self.shape.push(d.corners.clone());
         self.sweep.push(d.sweep);
+        self.copy.push(0);
         id
     }
 
@@ -149,11 +153,55 @@ impl Particles {
         self.active = gather(&self.active, order);
         self.material = gather(&self.material, order);
         self.sweep = gather(&self.sweep, order);
+        self.copy = gather(&self.copy, order);
         let mut shape = std::mem::take(&mut self.shape);
         self.shape = order
             .iter()
             .map(|&k| std::mem::take(&mut shape[k as usize]))
             .collect();
+    }
+
+    /// Whether particle j is active and of copy `copy` (what a copy's sources and
+    /// layered blocks see).
+    #[inline]
+    pub fn present_in(&self, j: usize, copy: u32) -> bool {
+        self.active[j] && self.copy[j] == copy
+    }
+
+    /// Appends all of `other`'s particles, as copy `copy`.
+    pub fn append(&mut self, other: &Particles, copy: u32) {
+        for k in 0..GEAR_VALUES {
+            self.q[k].extend_from_slice(&other.q[k]);
+        }
+        self.radius.extend_from_slice(&other.radius);
+        self.mass.extend_from_slice(&other.mass);
+        self.inertia.extend_from_slice(&other.inertia);
+        self.fixed.extend_from_slice(&other.fixed);
+        self.active.extend_from_slice(&other.active);
+        self.material.extend_from_slice(&other.material);
+        self.shape.extend(other.shape.iter().cloned());
+        self.sweep.extend_from_slice(&other.sweep);
+        self.copy.extend(std::iter::repeat_n(copy, other.len()));
+    }
+
+    /// The particles of copy `copy`, in their order, and for each its index here.
+    pub fn of_copy(&self, copy: u32) -> (Particles, Vec<usize>) {
+        let index: Vec<usize> = (0..self.len()).filter(|&i| self.copy[i] == copy).collect();
+        let pick = |v: &[f64]| index.iter().map(|&i| v[i]).collect::<Vec<f64>>();
+        let mut p = Particles {
+            q: std::array::from_fn(|k| index.iter().map(|&i| self.q[k][i]).collect()),
+            radius: pick(&self.radius),
+            mass: pick(&self.mass),
+            inertia: pick(&self.inertia),
+            fixed: index.iter().map(|&i| self.fixed[i]).collect(),
+            active: index.iter().map(|&i| self.active[i]).collect(),
+            material: index.iter().map(|&i| self.material[i]).collect(),
+            shape: index.iter().map(|&i| self.shape[i].clone()).collect(),
+            sweep: pick(&self.sweep),
+            copy: Vec::new(),
+        };
+        p.copy = vec![0; index.len()];
+        (p, index)
     }
 
     pub fn max_radius(&self) -> f64 {

@@ -87,24 +87,25 @@ fn grid(spec: &Layered, odd: bool) -> Vec<f64> {
         .collect()
 }
 
-/// Top of the material within `reach` of x (the floor where there is none).
-fn surface(spec: &Layered, particles: &Particles, x: f64, reach: f64) -> f64 {
+/// Top of the material of copy `copy` within `reach` of x (the floor where there is
+/// none).
+fn surface(spec: &Layered, particles: &Particles, x: f64, reach: f64, copy: u32) -> f64 {
     (0..particles.len())
-        .filter(|&j| particles.active[j])
+        .filter(|&j| particles.present_in(j, copy))
         .filter(|&j| (particles.q[0][j][0] - x).abs() < reach)
         .map(|j| particles.q[0][j][1] + particles.radius[j])
         .fold(spec.base_z, f64::max)
 }
 
 /// The positions of measured row k that still lie under the outline.
-fn measured_row(spec: &Layered, particles: &Particles, odd: bool) -> Vec<f64> {
+fn measured_row(spec: &Layered, particles: &Particles, odd: bool, copy: u32) -> Vec<f64> {
     let d = largest(spec);
     let h = 0.5 * 3f64.sqrt() * d;
     let tan = spec.slope.to_radians().tan();
     grid(spec, odd)
         .into_iter()
         .filter(|&x| {
-            let top = surface(spec, particles, x, 0.5 * d) - spec.base_z;
+            let top = surface(spec, particles, x, 0.5 * d, copy) - spec.base_z;
             let height = (top - (d - h)).max(0.0);
             height <= (0.5 * spec.base_width - (x - spec.center_x).abs() - 0.5 * d) * tan
         })
@@ -114,7 +115,7 @@ fn measured_row(spec: &Layered, particles: &Particles, odd: bool) -> Vec<f64> {
 /// The x of the particles of row k: evenly spaced across the fixed row, or the measured
 /// row's grid positions under the outline (the other offset's if none of its own are
 /// left; none when the pile is finished).
-fn row_positions(spec: &Layered, particles: &Particles, k: u32) -> Vec<f64> {
+fn row_positions(spec: &Layered, particles: &Particles, k: u32, copy: u32) -> Vec<f64> {
     if spec.row_height.is_some() {
         let w = row_width(spec, k);
         let n = row_size(spec, k);
@@ -124,9 +125,9 @@ fn row_positions(spec: &Layered, particles: &Particles, k: u32) -> Vec<f64> {
             .collect();
     }
     let odd = k % 2 == 1;
-    let xs = measured_row(spec, particles, odd);
+    let xs = measured_row(spec, particles, odd, copy);
     if xs.is_empty() {
-        measured_row(spec, particles, !odd)
+        measured_row(spec, particles, !odd, copy)
     } else {
         xs
     }
@@ -139,20 +140,22 @@ pub fn due(spec: &Layered, state: &SourceState, t: f64) -> bool {
     t >= spec.start_time + k as f64 * spec.interval && k < max_rows(spec)
 }
 
-/// The particles of the rows due by time t (at most one row per call).
+/// The particles of the rows due by time t (at most one row per call), on the pile of
+/// copy `copy`.
 pub fn emit(
     spec: &Layered,
     state: &mut SourceState,
     t: f64,
     material: u32,
     particles: &Particles,
+    copy: u32,
 ) -> Vec<NewParticle> {
     if !due(spec, state, t) {
         return Vec::new();
     }
     let k = state.inserted;
     let d = largest(spec);
-    let xs = row_positions(spec, particles, k);
+    let xs = row_positions(spec, particles, k, copy);
     if xs.is_empty() {
         // The pile has reached its outline: no more rows.
         state.inserted = max_rows(spec);
@@ -166,7 +169,7 @@ pub fn emit(
             spec.polygon.as_ref(),
             &mut state.rng,
         );
-        let z = surface(spec, particles, x, d) + 0.5 * d + spec.gap * d;
+        let z = surface(spec, particles, x, d, copy) + 0.5 * d + spec.gap * d;
         out.push(particle_at(
             spec.polygon.as_ref(),
             &drawn,

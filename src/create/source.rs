@@ -208,10 +208,10 @@ pub fn particle_at(
     }
 }
 
-/// Whether a disk at `p` with radius `r` would touch an active particle.
-fn is_free(particles: &Particles, p: [f64; 2], r: f64) -> bool {
+/// Whether a disk at `p` with radius `r` would touch an active particle of copy `copy`.
+fn is_free(particles: &Particles, p: [f64; 2], r: f64, copy: u32) -> bool {
     (0..particles.len()).all(|j| {
-        if !particles.active[j] {
+        if !particles.present_in(j, copy) {
             return true;
         }
         let q = particles.position(j);
@@ -221,13 +221,15 @@ fn is_free(particles: &Particles, p: [f64; 2], r: f64) -> bool {
     })
 }
 
-/// The disks that source `spec` places at time `t`; at most those due by then.
+/// The disks that source `spec` of copy `copy` places at time `t`; at most those due
+/// by then, where no particle of that copy is in the way.
 pub fn emit(
     spec: &PointSource,
     state: &mut SourceState,
     t: f64,
     material: u32,
     particles: &Particles,
+    copy: u32,
 ) -> Vec<NewParticle> {
     let mut out = Vec::new();
     while due(spec, state, t) && (out.len() as u32) < MAX_PER_STEP {
@@ -242,7 +244,7 @@ pub fn emit(
             let (dx, dz) = (o.position[0] - pos[0], o.position[1] - pos[1]);
             dx * dx + dz * dz >= (o.radius + new.radius).powi(2)
         });
-        if !(fresh_ok && is_free(particles, pos, new.radius)) {
+        if !(fresh_ok && is_free(particles, pos, new.radius, copy)) {
             state.pending = Some(drawn);
             break;
         }

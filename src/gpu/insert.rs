@@ -58,6 +58,7 @@ impl GpuSimulation {
                 t,
                 b.material,
                 &self.sim.particles,
+                0,
             );
             for np in &new {
                 let mut one = Particles::default();

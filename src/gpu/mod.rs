@@ -276,6 +276,12 @@ impl GpuSimulation {
         if let Some(reason) = unsupported_spheropolygons(&sim) {
             return Err(GpuError::Unsupported(reason));
         }
+        if sim.scene.replicas > 1 {
+            return Err(GpuError::Unsupported(format!(
+                "copies of a scene (replicas = {}) are not on the GPU path yet",
+                sim.scene.replicas
+            )));
+        }
         let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);
         if !point_sources.is_empty() && !layered_specs.is_empty() {
             return Err(GpuError::Unsupported(

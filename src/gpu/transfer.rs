@@ -223,6 +223,8 @@ pub fn from_device(
             _ => 0.0,
         };
         p.sweep.push(sweep);
+        // The GPU path runs scenes without copies (`replicas` 1).
+        p.copy.push(0);
     }
     p
 }

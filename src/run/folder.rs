@@ -9,7 +9,7 @@ use std::path::Path;
 
 /// What a run writes into its folder. Not `scene.json`: it is written over, and may be
 /// the user's own scene file.
-const OUTPUTS: [&str; 8] = [
+const OUTPUTS: [&str; 9] = [
     "snapshots",
     "checkpoints",
     "log.csv",
@@ -18,6 +18,7 @@ const OUTPUTS: [&str; 8] = [
     "final.bin",
     "analysis",
     "pictures",
+    "copies",
 ];
 
 /// What `claim` found and removed.

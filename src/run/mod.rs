@@ -88,6 +88,9 @@ pub enum RunError {
         reason: String,
         checkpoint: String,
     },
+    /// A copy of the scene (`replicas`) could not be taken apart: a bug.
+    #[error("copy of the scene: {0}")]
+    Copy(crate::scene::SceneError),
     #[error("run diverged at step {step} (t = {time:.6e}): {cause}; {checkpoint}")]
     Diverged {
         step: u64,
@@ -251,10 +254,55 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
         final_snapshot: final_json.display().to_string(),
         last_checkpoint: outputs.last_checkpoint().map(|p| p.display().to_string()),
     };
+    if sim.scene.replicas > 1 {
+        write_copies(sim, out, &summary, &settling.copies_settled())?;
+    }
     let text = serde_json::to_string_pretty(&summary).expect("summary serialises");
     let summary_path = out.join("summary.json");
     write_atomic(&summary_path, text.as_bytes()).map_err(io(&summary_path))?;
     Ok(summary)
+}
+
+/// The folder of copy `c` of a run with copies (`replicas`).
+pub fn copy_dir(out: &Path, c: u32) -> PathBuf {
+    out.join("copies").join(format!("copy_{c:04}"))
+}
+
+/// Each copy of a scene with `replicas` as a run of its own in `copies/copy_CCCC/`: its
+/// scene (with the copy's seed), final state and summary, as the run of that seed alone
+/// writes them (the folder can be analysed like any run's).
+fn write_copies(
+    sim: &Simulation,
+    out: &Path,
+    whole: &RunSummary,
+    settled: &[bool],
+) -> Result<(), RunError> {
+    for c in 0..sim.scene.replicas {
+        let copy = sim.replica(c).map_err(RunError::Copy)?;
+        let dir = copy_dir(out, c);
+        std::fs::create_dir_all(&dir).map_err(io(&dir))?;
+        let scene_path = dir.join("scene.json");
+        let text = serde_json::to_string_pretty(&copy.scene).expect("a scene always serialises");
+        write_atomic(&scene_path, text.as_bytes()).map_err(io(&scene_path))?;
+        let final_json = snapshot::write(&copy, &dir, "final").map_err(io(&dir))?;
+        let e = copy.energies();
+        let summary = RunSummary {
+            scene: copy.scene.name.clone(),
+            particles: copy.particles.active_count(),
+            mobile: copy.particles.mobile_count(),
+            lost: copy.lost,
+            settled: settled.get(c as usize).copied().unwrap_or(false),
+            kinetic_energy: e.kinetic(),
+            elastic_energy: e.elastic,
+            final_snapshot: final_json.display().to_string(),
+            last_checkpoint: None,
+            ..whole.clone()
+        };
+        let text = serde_json::to_string_pretty(&summary).expect("summary serialises");
+        let path = dir.join("summary.json");
+        write_atomic(&path, text.as_bytes()).map_err(io(&path))?;
+    }
+    Ok(())
 }
 
 /// Says what `folder::claim` removed.

@@ -356,74 +356,108 @@ fn checkpoint_step(path: &Path) -> Option<u64> {
     (digits.len() == 10).then(|| digits.parse().ok())?
 }
 
-/// The settling rules of `stop`, checked every `stop.check_every` (else every step).
+/// The settling rules of `stop`, checked every `stop.check_every` (else every step). A
+/// scene with copies (`replicas`) has the rules once per copy, each copy judged on its
+/// own (`Simulation::replica`); a copy that has settled stays settled, and the run ends
+/// when every copy has.
 pub struct Settling {
     pub every: Schedule,
+    rules: Vec<Rule>,
+}
+
+/// One copy's settling rules and what they have seen.
+struct Rule {
     kinetic_drop: Option<f64>,
     kinetic_fraction: Option<f64>,
     not_before: f64,
     /// The mean kinetic energy per particle when the relaxation began (`kinetic_drop`).
     relaxing_from: Option<f64>,
+    settled: bool,
 }
 
 impl Settling {
     pub fn new(scene: &Scene) -> Self {
         let every = Schedule::every(scene.stop.check_every, scene.dt);
+        let rule = || Rule {
+            kinetic_drop: scene.stop.kinetic_drop,
+            kinetic_fraction: scene.stop.kinetic_fraction,
+            not_before: scene.stop.not_before,
+            relaxing_from: None,
+            settled: false,
+        };
         Settling {
             every: if every == Schedule::NEVER {
                 Schedule::steps(1)
             } else {
                 every
             },
-            kinetic_drop: scene.stop.kinetic_drop,
-            kinetic_fraction: scene.stop.kinetic_fraction,
-            not_before: scene.stop.not_before,
-            relaxing_from: None,
+            rules: (0..scene.replicas).map(|_| rule()).collect(),
         }
     }
 
-    /// Whether the run has settled at `time`; says so through `progress`.
+    /// Which copies have settled (one entry without copies).
+    pub fn copies_settled(&self) -> Vec<bool> {
+        self.rules.iter().map(|r| r.settled).collect()
+    }
+
+    /// Whether the run has settled at `time` (every copy of it); says so through
+    /// `progress`.
     pub fn settled(
         &mut self,
         engine: &mut Engine,
         time: f64,
         progress: &Progress,
     ) -> Result<bool, RunError> {
+        let sim = engine.sim()?;
+        if let [rule] = &mut self.rules[..] {
+            return Ok(rule.check(sim, time, progress, ""));
+        }
+        for (c, rule) in self.rules.iter_mut().enumerate() {
+            if !rule.settled {
+                let copy = sim.replica(c as u32).map_err(RunError::Copy)?;
+                rule.settled = rule.check(&copy, time, progress, &format!("copy {c}: "));
+            }
+        }
+        Ok(self.rules.iter().all(|r| r.settled))
+    }
+}
+
+impl Rule {
+    /// Whether `sim` has settled at `time`; says so through `progress`, after `who`.
+    fn check(&mut self, sim: &Simulation, time: f64, progress: &Progress, who: &str) -> bool {
         if time < self.not_before {
-            return Ok(false);
+            return false;
         }
         if let Some(drop) = self.kinetic_drop
-            && engine.sim()?.feeding_done()
+            && sim.feeding_done()
         {
             // Paper 004's rule: the mean kinetic energy against its value when the
             // relaxation began (the first check after the sources are done).
-            let sim = engine.sim()?;
             let n = sim.particles.active_count().max(1) as f64;
             let mean = sim.energies().kinetic() / n;
             let start = *self.relaxing_from.get_or_insert(mean);
             if mean < drop * start {
                 progress.note(&format!(
-                    "relaxed at t = {:.4}: mean kinetic energy {mean:.3e}, {:.1e} of its {start:.3e} when the sources were done",
+                    "{who}relaxed at t = {:.4}: mean kinetic energy {mean:.3e}, {:.1e} of its {start:.3e} when the sources were done",
                     sim.time(),
                     mean / start
                 ));
-                return Ok(true);
+                return true;
             }
         }
-        if let Some(frac) = self.kinetic_fraction {
-            let sim = engine.sim()?;
-            if sim.feeding_done() {
-                let e = sim.energies();
-                if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
-                    progress.note(&format!(
-                        "settled at t = {:.4}: kinetic/elastic = {:.3e}",
-                        sim.time(),
-                        e.kinetic() / e.elastic
-                    ));
-                    return Ok(true);
-                }
+        if let Some(frac) = self.kinetic_fraction
+            && sim.feeding_done()
+        {
+            let e = sim.energies();
+            if e.elastic > 0.0 && e.kinetic() < frac * e.elastic {
+                progress.note(&format!(
+                    "{who}settled at t = {:.4}: kinetic/elastic = {:.3e}",
+                    sim.time(),
+                    e.kinetic() / e.elastic
+                ));
+                return true;
             }
         }
-        Ok(false)
+        false
     }
 }

@@ -37,6 +37,21 @@ pub struct Scene {
     /// speed, never the results.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub skin: Option<f64>,
+    /// Independent copies of the scene in one simulation (default 1): copy c has the
+    /// seed `seed + c`, its own particles, sources and random streams, and touches only
+    /// its own particles (and the walls). Written out and analysed as one run each
+    /// (`copies/copy_CCCC/`). Not written when 1, so a scene without copies reads and
+    /// writes as before.
+    #[serde(default = "one_copy", skip_serializing_if = "is_one_copy")]
+    pub replicas: u32,
+}
+
+fn one_copy() -> u32 {
+    1
+}
+
+fn is_one_copy(k: &u32) -> bool {
+    *k == 1
 }
 
 fn default_name() -> String {

@@ -381,6 +381,9 @@ fn polygons(scene: &Scene) -> Result<(), SceneError> {
 }
 
 /// Checks every value; returns warnings that do not stop a run.
+/// The most copies a scene may ask for (`replicas`).
+pub const MAX_REPLICAS: u32 = 4096;
+
 pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
     let mut warnings = Vec::new();
     // Without --out the name is the output folder (runs/<name>): a path in it would
@@ -438,10 +441,20 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
             "must be a positive number",
         ));
     }
+    if !(1..=MAX_REPLICAS).contains(&scene.replicas) {
+        return Err(SceneError::invalid(
+            "replicas",
+            format!(
+                "must be between 1 and {MAX_REPLICAS}, got {}",
+                scene.replicas
+            ),
+        ));
+    }
     let mut total = 0.0;
     for (k, c) in scene.particles.iter().enumerate() {
         let (n, key) = estimated_particles(c);
-        total += n;
+        // Every copy creates as many.
+        total += n * scene.replicas as f64;
         if total > limit {
             return Err(SceneError::invalid(
                 format!("particles[{k}].{key}"),
