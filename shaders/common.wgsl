@@ -15,9 +15,11 @@ const LAW_SPRING_DASHPOT: u32 = 0u;
 const LAW_CONTINUOUS: u32 = 1u;
 const LAW_AREA: u32 = 2u;
 const LAW_HERTZ: u32 = 3u;
-// Props.flags
+// Props.flags: ACTIVE | FIXED | material << MATERIAL_SHIFT | copy << COPY_SHIFT
 const ACTIVE: u32 = 1u;
 const FIXED: u32 = 2u;
+const MATERIAL_SHIFT: u32 = 8u;
+const COPY_SHIFT: u32 = 20u;
 // control[] words
 const C_STEP: u32 = 0u;
 const C_LIVE: u32 = 1u;
@@ -141,7 +143,7 @@ struct Props {
     radius: f32,
     mass: f32,
     inv_inertia: f32,   // 0 for fixed rotation
-    flags: u32,         // ACTIVE | FIXED | material << 8
+    flags: u32,         // ACTIVE | FIXED | material << 8 | copy << 20
     radius_units: u32,  // the radius in fixed point (position.wgsl)
     radius_rem: f32,
     shape: vec2<u32>,   // polygon corners: first index in `corners`, count (0: disk)
@@ -219,6 +221,11 @@ fn is_active(i: u32) -> bool {
 
 fn is_fixed(i: u32) -> bool {
     return (props[i].flags & FIXED) != 0u;
+}
+
+// The copy of the scene particle i belongs to (`replicas`): it touches only its own.
+fn copy_of(flags: u32) -> u32 {
+    return flags >> COPY_SHIFT;
 }
 
 fn is_integrated(i: u32) -> bool {

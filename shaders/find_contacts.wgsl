@@ -41,6 +41,7 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     var n = 0u;
     let id_i = ids[i];
     let fixed_i = is_fixed(i);
+    let copy_i = copy_of(props[i].flags);
     let c = cell_coords(state[i].anchor);
     let z0 = max(i32(c.y) - 1, 0);
     let z1 = min(c.y + 1u, params.nz - 1u);
@@ -57,6 +58,8 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
                 let j = sorted[s];
                 let id_j = ids[j];
                 if (id_j <= id_i || (fixed_i && is_fixed(j))) { continue; }
+                // Copies of the scene share the cells but never touch.
+                if (copy_of(props[j].flags) != copy_i) { continue; }
                 // A bucket of a hashed grid may hold other cells too (and be visited
                 // for each of them): only this cell's particles count here.
                 if (hashed && any(cell_coords(state[j].anchor) != vec2<u32>(x, z))) { continue; }

@@ -137,6 +137,8 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("EMPTY", layout::EMPTY as f64),
         ("ACTIVE", layout::ACTIVE as f64),
         ("FIXED", layout::FIXED as f64),
+        ("MATERIAL_SHIFT", layout::MATERIAL_SHIFT as f64),
+        ("COPY_SHIFT", layout::COPY_SHIFT as f64),
         ("INSERT_WINDOW", layout::INSERT_WINDOW as f64),
         ("LAW_SPRING_DASHPOT", layout::LAW_SPRING_DASHPOT as f64),
         ("LAW_CONTINUOUS", layout::LAW_CONTINUOUS as f64),

@@ -1,6 +1,7 @@
 //! Copies of a scene in one simulation (`replicas`, issue 17 item 4): copy c is bitwise
-//! the run of seed `seed + c` alone on the CPU path, through pouring, layer-by-layer
-//! construction, polygons, a checkpoint and the run folder's outputs; copies never touch.
+//! the run of seed `seed + c` alone on the same path (CPU, and GPU on whatever adapter
+//! there is), through pouring, layer-by-layer construction, polygons, a checkpoint and
+//! the run folder's outputs; copies never touch.
 
 mod common;
 
@@ -22,20 +23,31 @@ fn pour(extra: &[&str]) -> Scene {
     scene::parse(scene::DEFAULT_SCENE, &o).unwrap()
 }
 
-/// Steps `sim` and, alone, each copy's scene the same number of steps, and requires
-/// every copy to be bitwise its lone run: particles, contacts, sources.
-fn copies_match_lone_runs(scene: Scene, steps: u64) {
+/// Steps the scene with copies and, alone, each copy's scene the same number of steps
+/// on `path`, and requires every copy to be bitwise its lone run: particles, contacts,
+/// lost particles. None when the path has no adapter (the GPU, skipped with a message).
+fn copies_match_lone_runs(path: common::Path, scene: Scene, steps: u64) -> Option<()> {
     let k = scene.replicas;
     assert!(k > 1);
-    let mut sim = Simulation::new(scene.clone()).unwrap();
-    sim.advance(steps).unwrap();
+    let mut e = common::engine(
+        path,
+        "copies of a scene",
+        Simulation::new(scene.clone()).unwrap(),
+    )?;
+    e.advance(steps).unwrap();
+    let sim = e.sim().unwrap();
     for c in 0..k {
         let copy = sim.replica(c).unwrap();
         let mut alone = scene.clone();
         alone.replicas = 1;
         alone.seed = scene.seed + c as u64;
-        let mut lone = Simulation::new(alone.clone()).unwrap();
+        let mut lone = common::engine(
+            path,
+            "a copy alone",
+            Simulation::new(alone.clone()).unwrap(),
+        )?;
         lone.advance(steps).unwrap();
+        let lone = lone.sim().unwrap();
         assert_eq!(copy.scene.seed, alone.seed);
         assert!(copy.particles.len() > 2, "copy {c} is empty");
         assert_eq!(
@@ -52,7 +64,7 @@ fn copies_match_lone_runs(scene: Scene, steps: u64) {
                     .collect()
             };
             assert!(
-                bits(&copy) == bits(&lone),
+                bits(&copy) == bits(lone),
                 "copy {c}: Gear value {g} differs"
             );
         }
@@ -65,13 +77,16 @@ fn copies_match_lone_runs(scene: Scene, steps: u64) {
     // The copies are not the same heap (different seeds).
     let (a, b) = (sim.replica(0).unwrap(), sim.replica(1).unwrap());
     assert_ne!(a.particles.q[0], b.particles.q[0]);
+    Some(())
 }
 
 #[test]
 fn each_copy_of_a_pour_is_the_run_of_its_seed_alone() {
     // Several copies of a pour in one simulation; each lies exactly where the others'
     // grains are, so any contact between copies would show.
-    copies_match_lone_runs(pour(&["replicas=3"]), 6000);
+    for path in common::PATHS {
+        copies_match_lone_runs(path, pour(&["replicas=3"]), 6000);
+    }
 }
 
 #[test]
@@ -88,7 +103,9 @@ fn each_copy_of_a_layered_polygon_pile_is_its_run_alone() {
     v["seed"] = json!(5);
     v["replicas"] = json!(2);
     v["integrator"] = json!("leapfrog");
-    copies_match_lone_runs(common::parse(&v), 3000);
+    for path in common::PATHS {
+        copies_match_lone_runs(path, common::parse(&v), 3000);
+    }
 }
 
 #[test]
@@ -117,7 +134,7 @@ fn copies_survive_a_checkpoint() {
 }
 
 #[test]
-fn replicas_are_checked_and_refused_on_the_gpu_path() {
+fn replicas_are_checked() {
     for bad in ["replicas=0", "replicas=5000", "replicas=-1", "replicas=1.5"] {
         let e = scene::parse(scene::DEFAULT_SCENE, &[bad.into()])
             .unwrap_err()
@@ -132,14 +149,6 @@ fn replicas_are_checked_and_refused_on_the_gpu_path() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("limits.max_particles"), "{e}");
-    let sim = Simulation::new(pour(&["replicas=2"])).unwrap();
-    if let Some(gpu) = common::gpu("replicas refused") {
-        let start = talus::checkpoint::Checkpoint::fresh(sim);
-        match talus::gpu::GpuSimulation::resume_with_gpu(start, gpu) {
-            Err(e) => assert!(e.to_string().contains("replicas = 2"), "{e}"),
-            Ok(_) => panic!("copies ran on the GPU path"),
-        }
-    }
 }
 
 #[test]

@@ -16,6 +16,8 @@ pub(super) struct LayeredBase {
     pub(super) spec: Layered,
     pub(super) material: u32,
     pub(super) index: usize,
+    /// The copy of the scene it builds on (`replicas`).
+    pub(super) copy: u32,
 }
 
 impl GpuSimulation {
@@ -58,11 +60,12 @@ impl GpuSimulation {
                 t,
                 b.material,
                 &self.sim.particles,
-                0,
+                b.copy,
             );
             for np in &new {
                 let mut one = Particles::default();
                 create::push(&self.sim.scene, &mut one, np);
+                one.copy[0] = b.copy;
                 if gear {
                     one.q[2][0] = [h * g[0], h * g[1], 0.0];
                 }
@@ -149,7 +152,14 @@ pub(super) fn upcoming(
     // Polygon corners: every particle's in id order, then every candidate's.
     let mut corner_table = transfer::corner_table(&sim.particles);
     let dt = sim.dt();
-    for (spec, st) in specs.iter().zip(&sim.sources) {
+    // Copy after copy (`replicas`), each copy's point sources in scene order: the order
+    // in which the CPU path inserts.
+    let per_copy = specs.len() + layered_specs.len();
+    for (s, st) in sim.sources.iter().enumerate() {
+        let (copy, k) = (s / per_copy.max(1), s % per_copy.max(1));
+        let Some(spec) = specs.get(k) else {
+            continue;
+        };
         let list = source::upcoming(spec, st);
         source_rows.push(Source {
             first: candidates.len() as u32,
@@ -183,7 +193,7 @@ pub(super) fn upcoming(
                 mass: one.mass[0] as f32,
                 inv_inertia: (1.0 / one.inertia[0]) as f32,
                 due_step: due.min(u32::MAX as u64) as u32,
-                flags: ACTIVE | (material << 8),
+                flags: layout::flags(true, false, material, copy as u32),
                 radius_units,
                 radius_rem,
                 turn,
@@ -202,19 +212,22 @@ pub(super) fn upcoming(
     let mut layered = Vec::new();
     let mut layered_count = 0u32;
     let mut layered_corners = 0usize;
-    for (m, spec) in layered_specs.iter().enumerate() {
-        let index = specs.len() + m;
-        let corners = spec.polygon.as_ref().map_or(0, |p| p.corners as usize);
-        for k in sim.sources[index].inserted..create::layered::max_rows(spec) {
-            let n = create::layered::row_capacity(spec, k);
-            layered_count += n as u32;
-            layered_corners += n * corners;
+    for copy in 0..sim.scene.replicas {
+        for (m, spec) in layered_specs.iter().enumerate() {
+            let index = copy as usize * per_copy + specs.len() + m;
+            let corners = spec.polygon.as_ref().map_or(0, |p| p.corners as usize);
+            for k in sim.sources[index].inserted..create::layered::max_rows(spec) {
+                let n = create::layered::row_capacity(spec, k);
+                layered_count += n as u32;
+                layered_corners += n * corners;
+            }
+            layered.push(LayeredBase {
+                spec: spec.clone(),
+                material: crate::create::material_index(&sim.scene, &spec.material),
+                index,
+                copy,
+            });
         }
-        layered.push(LayeredBase {
-            spec: spec.clone(),
-            material: crate::create::material_index(&sim.scene, &spec.material),
-            index,
-        });
     }
     Upcoming {
         sources,

@@ -13,6 +13,18 @@ pub const INSERT_WINDOW: u32 = 4;
 pub const EMPTY: u32 = u32::MAX;
 pub const ACTIVE: u32 = 1;
 pub const FIXED: u32 = 2;
+/// `Props.flags`: ACTIVE | FIXED | material << MATERIAL_SHIFT | copy << COPY_SHIFT
+/// (the copy of the scene, `replicas`; materials below 2¹², copies below 2¹²).
+pub const MATERIAL_SHIFT: u32 = 8;
+pub const COPY_SHIFT: u32 = 20;
+
+/// A particle's `Props.flags`.
+pub fn flags(active: bool, fixed: bool, material: u32, copy: u32) -> u32 {
+    (active as u32) * ACTIVE
+        | (fixed as u32) * FIXED
+        | (material << MATERIAL_SHIFT)
+        | (copy << COPY_SHIFT)
+}
 /// Workgroup size of the per-particle kernels (`WG`).
 pub const WG: u32 = 64;
 /// Workgroup size of the prefix sum (`SCAN_WG`).

@@ -276,10 +276,11 @@ impl GpuSimulation {
         if let Some(reason) = unsupported_spheropolygons(&sim) {
             return Err(GpuError::Unsupported(reason));
         }
-        if sim.scene.replicas > 1 {
+        // Props.flags holds material and copy in 12 bits each.
+        let field = 1usize << (layout::COPY_SHIFT - layout::MATERIAL_SHIFT);
+        if sim.scene.materials.len() > field || sim.scene.replicas as usize > field {
             return Err(GpuError::Unsupported(format!(
-                "copies of a scene (replicas = {}) are not on the GPU path yet",
-                sim.scene.replicas
+                "the GPU path holds at most {field} materials and {field} copies of a scene"
             )));
         }
         let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);
@@ -318,7 +319,8 @@ impl GpuSimulation {
         // Every particle the point sources will still insert is drawn now, on the host:
         // check that they fit the adapter before drawing them (a count of 4·10⁹ would
         // otherwise abort on allocation; issue 16).
-        let to_come: u64 = (point_sources.iter().zip(&sim.sources))
+        // (Every copy of the scene has its sources, copy after copy.)
+        let to_come: u64 = (point_sources.iter().cycle().zip(&sim.sources))
             .map(|(s, st)| s.count.saturating_sub(st.inserted) as u64)
             .sum();
         gpu.check_buffer(

@@ -135,8 +135,7 @@ pub fn to_device(p: &Particles, origin: [f64; 2], cell: f32) -> (Vec<State>, Vec
         }
         (s.q1_whole, s.q[1]) = split_q1(p.q[1][i], cell);
         states.push(s);
-        let flags =
-            ((p.active[i] as u32) * ACTIVE) | ((p.fixed[i] as u32) * FIXED) | (p.material[i] << 8);
+        let flags = super::layout::flags(p.active[i], p.fixed[i], p.material[i], p.copy[i]);
         let (radius_units, radius_rem) = position::length_units(p.radius[i], cell);
         props.push(Props {
             radius: p.radius[i] as f32,
@@ -213,7 +212,8 @@ pub fn from_device(
         });
         p.fixed.push(pr.flags & FIXED != 0);
         p.active.push(pr.flags & ACTIVE != 0);
-        p.material.push(pr.flags >> 8);
+        p.material
+            .push((pr.flags >> MATERIAL_SHIFT) & ((1 << (COPY_SHIFT - MATERIAL_SHIFT)) - 1));
         let [start, count] = pr.shape;
         let (start, end) = (start as usize, (start + count) as usize);
         p.shape.push(corner_table[start..end].to_vec());
@@ -223,8 +223,7 @@ pub fn from_device(
             _ => 0.0,
         };
         p.sweep.push(sweep);
-        // The GPU path runs scenes without copies (`replicas` 1).
-        p.copy.push(0);
+        p.copy.push(pr.flags >> COPY_SHIFT);
     }
     p
 }
