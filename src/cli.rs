@@ -692,22 +692,33 @@ fn cmd_reproduce(
         "variants": found,
         "failed": failed,
     });
+    finish_reproduction(&id, &root, &report, failed.len(), variants.len(), "failed")
+}
+
+/// Writes `root/reproduce.json`, says where the results are, and fails when `failed` of
+/// the `of` variants `what` (failed, or had failed runs).
+fn finish_reproduction(
+    id: &str,
+    root: &std::path::Path,
+    report: &serde_json::Value,
+    failed: usize,
+    of: usize,
+    what: &str,
+) -> Result<(), Failure> {
     let path = root.join("reproduce.json");
     talus::files::write_atomic(
         &path,
-        serde_json::to_string_pretty(&report).unwrap().as_bytes(),
+        serde_json::to_string_pretty(report).unwrap().as_bytes(),
     )
     .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
     out!(
         "{id}: {}; results in {}",
-        reproduce::claim(&id),
+        talus::reproduce::claim(id),
         root.display()
     );
-    if !failed.is_empty() {
+    if failed > 0 {
         return Err(Failure::failed(format!(
-            "{id}: {} of {} variants failed (listed in reproduce.json)",
-            failed.len(),
-            variants.len()
+            "{id}: {failed} of {of} variants {what} (listed in reproduce.json)"
         )));
     }
     Ok(())

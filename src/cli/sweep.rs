@@ -640,23 +640,12 @@ pub fn reproduce(
         "variants": statistics,
         "failed": failed,
     });
-    let path = root.join("reproduce.json");
-    talus::files::write_atomic(
-        &path,
-        serde_json::to_string_pretty(&report).unwrap().as_bytes(),
+    super::finish_reproduction(
+        &id,
+        &root,
+        &report,
+        failed.len(),
+        planned.len(),
+        "had failed runs",
     )
-    .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
-    out!(
-        "{id}: {}; results in {}",
-        reproduce::claim(&id),
-        root.display()
-    );
-    if !failed.is_empty() {
-        return Err(Failure::failed(format!(
-            "{id}: {} of {} variants had failed runs (listed in reproduce.json)",
-            failed.len(),
-            planned.len()
-        )));
-    }
-    Ok(())
 }
