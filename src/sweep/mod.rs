@@ -47,6 +47,11 @@ pub enum SweepError {
         source: SceneError,
     },
     #[error(
+        "run {run}: a sweep's runs are single copies of a scene (replicas = 1); sweep seeds \
+         with --seeds instead of replicas"
+    )]
+    Replicas { run: String },
+    #[error(
         "{dir} holds a different sweep (its sweep.json or scene.json differs from this one's): \
          choose another --out, or pass --force to remove that sweep's files first"
     )]
@@ -228,11 +233,15 @@ pub fn plan(
                 name.push_str(&label(&axis.key, &axis.values[v]));
             }
             name.push_str(&format!("-seed{seed}"));
-            scene::parse(&text, &overrides).map_err(|source| SweepError::Scene {
+            let scene = scene::parse(&text, &overrides).map_err(|source| SweepError::Scene {
                 run: name.clone(),
                 overrides: overrides.join(" "),
                 source,
             })?;
+            // Each run is measured as one heap; copies would lie on top of each other.
+            if scene.replicas > 1 {
+                return Err(SweepError::Replicas { run: name });
+            }
             runs.push(PlannedRun {
                 index,
                 name,
@@ -655,6 +664,13 @@ mod tests {
             .to_string();
         assert!(
             e.starts_with("run 0001-mu-1-seed1 (contact.mu=-1 seed=1): contact.mu"),
+            "{e}"
+        );
+        let copies = [parse_axis("replicas=1,2").unwrap()];
+        let e = plan(&base, &[1], &copies, "cpu", Measuring::default()).unwrap_err();
+        assert!(
+            e.to_string()
+                .starts_with("run 0001-replicas2-seed1: a sweep's runs"),
             "{e}"
         );
     }
