@@ -69,7 +69,7 @@ pub struct SweepArgs {
     /// Submit the job array with sbatch.
     #[arg(long, requires = "slurm")]
     submit: bool,
-    /// Only a line per finished run, no progress bar.
+    /// No progress bar or progress lines; still a line per finished run.
     #[arg(long, short)]
     quiet: bool,
 }
@@ -350,6 +350,16 @@ fn planned_steps(dir: &Path, run: &sweep::PlannedRun) -> u64 {
     sweep::run_scene(dir, run).map_or(0, |s| (s.stop.time / s.dt - 1e-9).ceil() as u64)
 }
 
+/// A line above the bar; straight to stderr where the bar is not drawn (not a terminal,
+/// or `--quiet`), where `println` would drop it.
+fn say(bar: &ProgressBar, line: String) {
+    if bar.is_hidden() {
+        eprintln!("{line}");
+    } else {
+        bar.println(line);
+    }
+}
+
 /// Runs the plan here, `jobs` runs at once, each on threads/jobs cores (at least one),
 /// with a bar over all runs' steps and a line per finished run; a failed run is reported
 /// and the others go on.
@@ -404,6 +414,8 @@ fn run_here(
     let failed: Mutex<Vec<String>> = Mutex::new(Vec::new());
     let done = AtomicUsize::new(0);
     let start = Instant::now();
+    let at_start = finished_steps.load(Ordering::Relaxed);
+    let mut next_line = at_start + (total / 10).max(1);
     std::thread::scope(|s| {
         for worker in &current {
             let (next, todo, failed, done) = (&next, &todo, &failed, &done);
@@ -413,7 +425,7 @@ fn run_here(
                 let pool = match rayon::ThreadPoolBuilder::new().num_threads(per_run).build() {
                     Ok(p) => p,
                     Err(e) => {
-                        bar.println(format!("error: a worker's threads: {e}"));
+                        say(bar, format!("error: a worker's threads: {e}"));
                         return;
                     }
                 };
@@ -434,15 +446,15 @@ fn run_here(
                         Ok(_) => {
                             finished_steps.fetch_add(planned[index], Ordering::Relaxed);
                             done.fetch_add(1, Ordering::Relaxed);
-                            bar.println(format!(
-                                "  {name}: measured ({:.1} s)",
-                                t.elapsed().as_secs_f64()
-                            ));
+                            say(
+                                bar,
+                                format!("  {name}: measured ({:.1} s)", t.elapsed().as_secs_f64()),
+                            );
                         }
                         Err(f) if f.code == super::failure::INTERRUPTED => {}
                         Err(f) => {
                             finished_steps.fetch_add(planned[index], Ordering::Relaxed);
-                            bar.println(format!("  failed: {}", f.message));
+                            say(bar, format!("  failed: {}", f.message));
                             failed
                                 .lock()
                                 .unwrap_or_else(|e| e.into_inner())
@@ -468,14 +480,27 @@ fn run_here(
                 .filter(|w| w.0.load(Ordering::Relaxed) != usize::MAX)
                 .map(|w| w.1.load(Ordering::Relaxed))
                 .sum();
-            bar.set_position(finished_steps.load(Ordering::Relaxed) + at);
-            bar.set_message(format!(
+            let position = finished_steps.load(Ordering::Relaxed) + at;
+            let message = format!(
                 "{}/{} runs done, {} running, {} failed",
                 skipped + done.load(Ordering::Relaxed),
                 plan.runs.len(),
                 running.len(),
                 failed.lock().unwrap_or_else(|e| e.into_inner()).len()
-            ));
+            );
+            bar.set_position(position);
+            bar.set_message(message.clone());
+            // Without a bar (CI, pipes): a line about every tenth of the steps.
+            if bar.is_hidden() && !quiet && position >= next_line && position < total {
+                let done_here = position.saturating_sub(at_start) as f64;
+                let eta =
+                    (total - position) as f64 * start.elapsed().as_secs_f64() / done_here.max(1.0);
+                eprintln!(
+                    "  {:>3.0}% {message}, ETA {eta:.0} s",
+                    100.0 * position as f64 / total.max(1) as f64
+                );
+                next_line = position + (total / 10).max(1);
+            }
             std::thread::sleep(Duration::from_millis(200));
         }
     });
