@@ -22,7 +22,10 @@ pub struct Measurement {
     pub workload: String,
     pub backend: String,
     pub shape: String,
+    /// Moving particles (the mean of the start and the end): what
+    /// `particle_steps_per_second` counts; fixed ones are `fixed`.
     pub particles: u64,
+    pub fixed: u64,
     pub steps: u64,
     pub seconds: f64,
     pub particle_steps_per_second: f64,
@@ -199,7 +202,7 @@ fn measure(
     let mut e = engine(sim, backend)?;
     let warm = if budget.is_some() { 10 } else { steps / 10 };
     e.advance(warm.clamp(1, steps.max(1)))?;
-    let n0 = e.active_count();
+    let n0 = e.mobile_count();
     let counters0 = gpu_counters(&e);
     let rebuilds0 = match &e {
         Engine::Cpu(s) => s.neighbours.rebuilds,
@@ -237,7 +240,9 @@ fn measure(
         empty = Some(per_step(indirect - ran));
         submissions = Some(per_step(c.submissions - c0.submissions));
     }
-    let n = (n0 + e.active_count()) / 2;
+    // Moving particles (fixed ones are never integrated), as other DEM codes count.
+    let n = (n0 + e.mobile_count()) / 2;
+    let fixed = e.active_count() - e.mobile_count();
     let (rebuilds, pairs, contacts) = match &e {
         Engine::Cpu(s) => {
             let per = |k: usize| Some(k as f64 / s.particles.active_count().max(1) as f64);
@@ -262,6 +267,7 @@ fn measure(
             "disk".into()
         },
         particles: n,
+        fixed,
         steps,
         seconds,
         particle_steps_per_second: (n * steps) as f64 / seconds.max(1e-12),

@@ -782,11 +782,12 @@ fn cmd_run(
     )?;
     if !quiet {
         eprintln!(
-            "done: {} steps to t = {:.4} ({}), {} particles ({} lost), {:.3e} particle-steps/s; results in {}",
+            "done: {} steps to t = {:.4} ({}), {} particles ({} moving, {} lost), {:.3e} particle-steps/s of the moving ones; results in {}",
             s.steps,
             s.time,
             if s.settled { "settled" } else { "end time" },
             s.particles,
+            s.mobile,
             s.lost,
             s.particle_steps_per_second,
             out.display()

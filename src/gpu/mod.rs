@@ -93,6 +93,9 @@ pub struct GpuSimulation {
     /// and losses on the device after the last submission.
     lost_base: u64,
     inactive_at_upload: u64,
+    /// Fixed particles at the upload: they never move, so never leave, and a source
+    /// inserts none.
+    fixed_at_upload: u64,
     lost_now: u64,
     /// The step the device is at (known on the host without a readback).
     step: u64,
@@ -402,6 +405,7 @@ impl GpuSimulation {
         let bind_groups = buffers.bind_groups(dev, &pipelines);
         let lost_base = sim.lost;
         let inactive_at_upload = (sim.particles.len() - sim.particles.active_count()) as u64;
+        let fixed_at_upload = (sim.particles.active_count() - sim.particles.mobile_count()) as u64;
         let step = sim.step;
         Ok(Self {
             sim,
@@ -418,6 +422,7 @@ impl GpuSimulation {
             layered: up.layered,
             lost_base,
             inactive_at_upload,
+            fixed_at_upload,
             lost_now: 0,
             step,
             live: n_now,
@@ -451,6 +456,11 @@ impl GpuSimulation {
     /// Active particles after the last submission (from the control words).
     pub fn active_count(&self) -> u64 {
         (self.live as u64).saturating_sub(self.inactive_at_upload + self.lost_now)
+    }
+
+    /// Active particles that move (not fixed), no readback.
+    pub fn mobile_count(&self) -> u64 {
+        self.active_count().saturating_sub(self.fixed_at_upload)
     }
 }
 

@@ -52,6 +52,15 @@ impl Engine {
         }
     }
 
+    /// Active particles that move (not fixed), no readback on the GPU: what throughput
+    /// counts.
+    pub fn mobile_count(&self) -> u64 {
+        match self {
+            Self::Cpu(s) => s.particles.mobile_count() as u64,
+            Self::Gpu(g) => g.mobile_count(),
+        }
+    }
+
     pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
         match self {
             Self::Cpu(s) => s.advance(steps),

@@ -43,6 +43,7 @@ pub struct RunSummary {
     pub backend: String,
     pub steps: u64,
     pub time: f64,
+    /// Active particles at the end, and of them the moving (not fixed) ones.
     pub particles: usize,
     pub mobile: usize,
     pub lost: u64,
@@ -51,6 +52,9 @@ pub struct RunSummary {
     pub kinetic_energy: f64,
     pub elastic_energy: f64,
     pub wall_seconds: f64,
+    /// Moving (not fixed) particles times steps, per second of wall time, as other DEM
+    /// codes count it: fixed particles are never integrated (issue 20: a pour's 200 base
+    /// disks counted in flattered the figure).
     pub particle_steps_per_second: f64,
     pub final_snapshot: String,
     pub last_checkpoint: Option<String>,
@@ -197,7 +201,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
             .min(settling.every.next_after(now))
             .min(progress_every.next_after(now))
             .min(total);
-        let active = engine.active_count();
+        let moving = engine.mobile_count();
         if let Err(cause) = engine.advance(next - now) {
             progress.finish();
             let step = engine.step();
@@ -217,7 +221,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
                 },
             });
         }
-        particle_steps += active * (next - now);
+        particle_steps += moving * (next - now);
         let step = next;
         outputs.write_due(engine)?;
         opts.step.store(step, Ordering::Relaxed);
