@@ -11,7 +11,7 @@ pub mod outputs;
 pub use engine::Engine;
 
 use crate::files::write_atomic;
-use crate::progress::Progress;
+use crate::progress::{Progress, Work};
 use crate::sim::{Divergence, Simulation};
 use crate::snapshot;
 use folder::Claimed;
@@ -124,6 +124,62 @@ pub fn total_steps(sim: &Simulation) -> u64 {
     (sim.scene.stop.time / sim.dt() - 1e-9).ceil() as u64
 }
 
+/// The moving particles expected at time `t` of a run now at `sim`: those there now
+/// and what every copy's point sources and layered blocks will have added by then at
+/// their rates (an insertion that has to wait for room comes later; lost particles are
+/// not foreseen).
+pub fn expected_moving(sim: &Simulation, t: f64) -> f64 {
+    use crate::create;
+    let (sources, layered) = crate::sim::creators(&sim.scene);
+    let per_copy = (sources.len() + layered.len()).max(1);
+    let mut n = sim.particles.mobile_count() as f64;
+    for (k, state) in sim.sources.iter().enumerate() {
+        let k = k % per_copy;
+        if let Some(s) = sources.get(k) {
+            let due = if t < s.start_time {
+                0
+            } else {
+                (((t - s.start_time) * s.rate).floor() as u64 + 1).min(s.count as u64)
+            };
+            n += due.saturating_sub(state.inserted as u64) as f64;
+        } else if let Some(l) = layered.get(k - sources.len()) {
+            let rows = if t < l.start_time {
+                0
+            } else {
+                (((t - l.start_time) / l.interval).floor() as u64 + 1)
+                    .min(create::layered::max_rows(l) as u64)
+            };
+            n += (state.inserted as u64..rows.max(state.inserted as u64))
+                .map(|r| create::layered::row_capacity(l, r as u32) as f64)
+                .sum::<f64>();
+        }
+    }
+    n
+}
+
+/// The particle-steps a run now at `sim` is expected to take until step `total`
+/// (`expected_moving` at 200 points between), for its progress and ETA.
+pub fn expected_work(sim: &Simulation, total: u64) -> Work {
+    let start = sim.step;
+    if total <= start {
+        return Work::steps(start, total.max(start + 1));
+    }
+    let dt = sim.scene.dt;
+    let points = 200.min(total - start);
+    let step_at = |k: u64| start + (total - start) * k / points;
+    let mut samples = vec![(start, 0.0)];
+    let mut work = 0.0;
+    let mut before = expected_moving(sim, start as f64 * dt);
+    for k in 1..=points {
+        let (a, b) = (step_at(k - 1), step_at(k));
+        let now = expected_moving(sim, b as f64 * dt);
+        work += 0.5 * (before + now) * (b - a) as f64;
+        samples.push((b, work.max(1e-9 * b as f64)));
+        before = now;
+    }
+    Work { samples }
+}
+
 /// Where to continue from: the newest checkpoint, in words for an error message.
 fn resume_hint(checkpoint: Option<&Path>, what: &str) -> String {
     match checkpoint {
@@ -159,7 +215,12 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
     let out = &opts.out;
     let start_step = engine.step();
     let total = total_steps(engine.host());
-    let mut progress = Progress::new(start_step, total, opts.quiet);
+    let mut progress = Progress::new(
+        start_step,
+        total,
+        opts.quiet,
+        expected_work(engine.host(), total),
+    );
     note_claim(&progress, &claimed, out, start_step);
     let scene = engine.host().scene.clone();
     let scene_path = out.join("scene.json");
