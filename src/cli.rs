@@ -73,6 +73,15 @@ enum Command {
         scene: Option<PathBuf>,
         #[arg(long = "set", value_name = "PATH=VALUE")]
         overrides: Vec<String>,
+        /// Also estimate the run time: the expected work (moving particles × steps, the
+        /// sources' insertions at their rates) over the particle-steps per second of a
+        /// few seconds of the scene itself on each backend (the CPU path, and a hardware
+        /// GPU when there is one; --backend gpu takes any adapter).
+        #[arg(long)]
+        estimate: bool,
+        /// The backends --estimate times (auto: the CPU path and a hardware GPU).
+        #[arg(long, value_enum, default_value_t = Backend::Auto, requires = "estimate")]
+        backend: Backend,
     },
     /// Print the built-in default scene.
     DefaultScene,
@@ -233,7 +242,12 @@ fn command(command: Command, threads: usize) -> ExitCode {
             backend,
             quiet,
         } => cmd_run(scene, out, overrides, resume, force, backend, quiet),
-        Command::Check { scene, overrides } => cmd_check(scene, overrides),
+        Command::Check {
+            scene,
+            overrides,
+            estimate,
+            backend,
+        } => cmd_check(scene, overrides, estimate.then_some(backend)),
         Command::DefaultScene => {
             out!("{}", scene::DEFAULT_SCENE.trim_end());
             Ok(())
@@ -724,7 +738,11 @@ fn finish_reproduction(
     Ok(())
 }
 
-fn cmd_check(path: Option<PathBuf>, overrides: Vec<String>) -> Result<(), Failure> {
+fn cmd_check(
+    path: Option<PathBuf>,
+    overrides: Vec<String>,
+    estimate: Option<Backend>,
+) -> Result<(), Failure> {
     let sim = build_simulation(&path, &overrides)?;
     out!(
         "scene `{}`: {} particles at start ({} fixed), {} steps of dt = {}",
@@ -734,7 +752,94 @@ fn cmd_check(path: Option<PathBuf>, overrides: Vec<String>) -> Result<(), Failur
         run::total_steps(&sim),
         sim.dt()
     );
+    if let Some(backend) = estimate {
+        estimate_run_time(sim, backend)?;
+    }
     Ok(())
+}
+
+/// `talus check --estimate`: the expected work of the run, and the time it takes on each
+/// backend at the particle-step rate of a few seconds of the scene itself. Timed from
+/// its start: a pour's first steps hold few grains with few contacts, cheaper per
+/// particle than the grown heap's, so for a long pour the estimate leans low (by 3× for
+/// the 50 000-polygon heap, whose grown pile runs at ~1.5·10⁶ per thread).
+fn estimate_run_time(sim: Simulation, backend: Backend) -> Result<(), Failure> {
+    let total = run::total_steps(&sim);
+    let work = run::expected_work(&sim, total);
+    out!(
+        "expected work: {:.3e} particle-steps (moving particles × steps, the insertions at their rates; to stop.time, the settling rule may end it sooner)",
+        work.total()
+    );
+    let hardware_gpu = matches!(
+        device::choose_adapter(),
+        Ok(a) if a.get_info().device_type != wgpu::DeviceType::Cpu
+    );
+    let mut backends = vec![Backend::Cpu];
+    match backend {
+        Backend::Cpu => {}
+        Backend::Gpu => backends = vec![Backend::Gpu],
+        Backend::Auto if hardware_gpu => backends.push(Backend::Gpu),
+        Backend::Auto => {
+            out!("(no hardware GPU: the CPU path only; --backend gpu times a software adapter)")
+        }
+    }
+    for b in backends {
+        let start = checkpoint::Checkpoint::fresh(sim.clone());
+        let mut engine = match b {
+            Backend::Gpu => Engine::Gpu(Box::new(GpuSimulation::resume(start)?)),
+            _ => Engine::cpu(start.sim),
+        };
+        // A warm-up, then doubling batches for about 3 s.
+        let warm = 10.min(total);
+        engine
+            .advance(warm)
+            .map_err(|e| Failure::failed(format!("the scene diverged while timed: {e}")))?;
+        let (from, t) = (engine.step(), std::time::Instant::now());
+        let mut batch = 8;
+        while t.elapsed().as_secs_f64() < 3.0 && engine.step() < total {
+            let k = batch.min(total - engine.step());
+            engine
+                .advance(k)
+                .map_err(|e| Failure::failed(format!("the scene diverged while timed: {e}")))?;
+            batch *= 2;
+        }
+        // The GPU runs ahead of the host: a readback waits for it.
+        let _ = engine.sim();
+        let seconds = t.elapsed().as_secs_f64();
+        let done = work.at(engine.step()) - work.at(from);
+        if done <= 0.0 {
+            out!(
+                "{}: no moving particles in the timed steps; no estimate",
+                engine.name()
+            );
+            continue;
+        }
+        let rate = done / seconds;
+        out!(
+            "{}: {rate:.3e} particle-steps/s over steps {from}–{} → about {} for the whole run{}",
+            engine.name(),
+            engine.step(),
+            duration(work.total() / rate),
+            if engine.step() < total / 2
+                && sim.particles.mobile_count() * 4 < work.total() as usize / total as usize
+            {
+                " (timed while the scene is still small: the grown heap costs more per particle, so this leans low)"
+            } else {
+                ""
+            }
+        );
+    }
+    Ok(())
+}
+
+/// A duration in words: seconds, minutes, hours or days.
+fn duration(seconds: f64) -> String {
+    match seconds {
+        s if s < 120.0 => format!("{s:.0} s"),
+        s if s < 7200.0 => format!("{:.0} min", s / 60.0),
+        s if s < 172_800.0 => format!("{:.1} h", s / 3600.0),
+        s => format!("{:.1} days", s / 86_400.0),
+    }
 }
 
 fn cmd_run(

@@ -674,3 +674,36 @@ fn bench_measures_a_software_adapter_only_when_asked() {
         );
     }
 }
+
+/// `talus check --estimate` says the run's expected work (the model of
+/// `run::expected_work`, tests/progress.rs) and a time for it on the CPU path.
+#[test]
+fn check_estimates_the_run_time() {
+    let set = ["--set", "stop.time=20", "--set", "particles[1].count=100"];
+    let mut args = vec!["check", "--estimate", "--backend", "cpu"];
+    args.extend(set);
+    let (code, out, err) = talus(&args);
+    assert_eq!(code, 0, "{err}");
+    let o: Vec<String> = set
+        .iter()
+        .skip(1)
+        .step_by(2)
+        .map(|s| s.to_string())
+        .collect();
+    let sim =
+        talus::sim::Simulation::new(talus::scene::parse(talus::scene::DEFAULT_SCENE, &o).unwrap())
+            .unwrap();
+    let work = talus::run::expected_work(&sim, talus::run::total_steps(&sim)).total();
+    assert!(
+        out.contains(&format!("expected work: {work:.3e} particle-steps")),
+        "{out}"
+    );
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("cpu:"))
+        .expect("a line for the CPU path");
+    assert!(
+        line.contains("particle-steps/s") && line.contains("for the whole run"),
+        "{line}"
+    );
+}
