@@ -120,6 +120,16 @@ struct Params {
     // limits.max_step_displacement, squared (0: no bound): the most a particle may move
     // in one step, as a fraction of its radius (survey.wgsl `survey_one_at`)
     max_step2: f32,
+    // The spring-dashpot law's coefficients per pair of materials (src/law/restitution.rs,
+    // src/gpu/layout.rs): slot s = a pair_side + b (b = pair_side - 1: a wall) has
+    // pair_law[2s] = (k_n, gamma_n, k_t, gamma_t) and pair_law[2s + 1].x = mu, per unit
+    // of the contact's effective mass when per_mass is 1.
+    pair_side: u32,
+    per_mass: u32,
+    pad_pair0: u32,
+    pad_pair1: u32,
+    pad_pair2: u32,
+    pair_law: array<vec4<f32>, 128>,
 };
 
 // Dynamic state: q[0] = (rem_x, rem_z, rem_theta, 0) with the position's remainder in
@@ -221,6 +231,31 @@ fn is_active(i: u32) -> bool {
 
 fn is_fixed(i: u32) -> bool {
     return (props[i].flags & FIXED) != 0u;
+}
+
+// A contact's slot in Params.pair_law: materials a and b of i and j, b = pair_side - 1
+// for a wall (src/law/restitution.rs `PairTable::slot`).
+fn pair_slot(i: u32, j: u32, wall: bool) -> u32 {
+    let side = params.pair_side;
+    if (side <= 1u) { return 0u; }
+    let a = (props[i].flags >> MATERIAL_SHIFT) & ((1u << (COPY_SHIFT - MATERIAL_SHIFT)) - 1u);
+    var b = side - 1u;
+    if (!wall) {
+        b = (props[j].flags >> MATERIAL_SHIFT) & ((1u << (COPY_SHIFT - MATERIAL_SHIFT)) - 1u);
+    }
+    return a * side + b;
+}
+
+// A contact's effective mass: the reduced mass with a fixed partner or a wall infinitely
+// heavy (src/law/restitution.rs `effective_mass`).
+fn effective_mass(i: u32, j: u32, wall: bool, m1: f32) -> f32 {
+    if (wall) { return m1; }
+    let m2 = props[j].mass;
+    let fixed_i = is_fixed(i);
+    let fixed_j = is_fixed(j);
+    if (fixed_j && !fixed_i) { return m1; }
+    if (fixed_i && !fixed_j) { return m2; }
+    return m1 * m2 / (m1 + m2);
 }
 
 // The copy of the scene particle i belongs to (`replicas`): it touches only its own.

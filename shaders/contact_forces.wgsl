@@ -141,8 +141,14 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
     // Relative velocity of the two surfaces at the contact point.
     let v12 = v1.xy + s1 - v2.xy - s2;
     let t = tangent(g.n);
+    var m_eff = m12;
+    var pair = 0u;
+    if (params.per_mass != 0u) {
+        m_eff = effective_mass(i, j, wall, m1);
+        pair = pair_slot(i, j, wall);
+    }
     let input = ContactInput(g.delta, g.r, g.sigma, -dot(v12, g.n) * rate, dot(v12, t),
-                             m12, mass, hist_in[slot], params.dt);
+                             m12, mass, hist_in[slot], params.dt, m_eff, pair);
     let res = evaluate(input);
     let f = res.f_n * g.n + res.f_t * t;
     contact_ft[slot] = vec4<f32>(f, cross2(l1, f), -cross2(l2, f));

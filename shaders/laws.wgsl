@@ -11,6 +11,11 @@ struct ContactInput {
     mass: f32,
     history: f32,
     dt: f32,
+    // The spring-dashpot law's pair of materials (slot of Params.pair_law) and the
+    // contact's effective mass, a fixed partner or a wall infinitely heavy
+    // (src/law/restitution.rs); the other laws ignore them.
+    m_eff: f32,
+    pair: u32,
 };
 
 struct ContactOutput {
@@ -26,47 +31,55 @@ fn pow_pos(x: f32, y: f32) -> f32 {
 }
 
 // f_el = k_n delta0 (delta/delta0)^nu, paper 000 eq. 2.
-fn elastic_force(delta: f32) -> f32 {
-    if (params.nu == 1.0) { return params.k_n * delta; }
-    return params.k_n * params.delta0 * pow_pos(delta / params.delta0, params.nu);
+fn elastic_force(k_n: f32, delta: f32) -> f32 {
+    if (params.nu == 1.0) { return k_n * delta; }
+    return k_n * params.delta0 * pow_pos(delta / params.delta0, params.nu);
 }
 
 // f_diss = gamma_n delta_dot (delta/delta0)^psi, paper 000 eq. 3.
-fn dissipative_force(delta: f32, delta_dot: f32) -> f32 {
-    if (params.psi == 0.0) { return params.gamma_n * delta_dot; }
-    return params.gamma_n * delta_dot * pow_pos(delta / params.delta0, params.psi);
+fn dissipative_force(gamma_n: f32, delta: f32, delta_dot: f32) -> f32 {
+    if (params.psi == 0.0) { return gamma_n * delta_dot; }
+    return gamma_n * delta_dot * pow_pos(delta / params.delta0, params.psi);
 }
 
-fn elastic_energy(delta: f32) -> f32 {
+fn elastic_energy(k_n: f32, delta: f32) -> f32 {
     let nu = params.nu;
-    return params.k_n * params.delta0 * params.delta0
+    return k_n * params.delta0 * params.delta0
         * pow_pos(delta / params.delta0, nu + 1.0) / (nu + 1.0);
-}
-
-// Coulomb-capped spring, paper 000 eq. 4-5: returns (f_t, new xi).
-fn coulomb_spring(xi0: f32, v_t: f32, dt: f32, f_n: f32) -> vec2<f32> {
-    return damped_coulomb_spring(xi0, v_t, dt, f_n, params.gamma_t);
 }
 
 // The same with the damping coefficient given (src/law/tangential.rs `coulomb_spring`).
 fn damped_coulomb_spring(xi0: f32, v_t: f32, dt: f32, f_n: f32, gamma_t: f32) -> vec2<f32> {
+    return coulomb_spring_with(xi0, v_t, dt, f_n, params.k_t, gamma_t, params.mu);
+}
+
+// Coulomb-capped spring, paper 000 eq. 4-5, with every coefficient given: returns
+// (f_t, new xi).
+fn coulomb_spring_with(xi0: f32, v_t: f32, dt: f32, f_n: f32, k_t: f32, gamma_t: f32,
+                       mu: f32) -> vec2<f32> {
     let xi = xi0 + v_t * dt;
-    let trial = -params.k_t * xi - gamma_t * v_t;
-    let cap = params.mu * f_n;
+    let trial = -k_t * xi - gamma_t * v_t;
+    let cap = mu * f_n;
     if (abs(trial) <= cap) { return vec2<f32>(trial, xi); }
     let f_t = select(-cap, cap, trial >= 0.0);
     var xs = 0.0;
-    if (params.k_t > 0.0) { xs = -f_t / params.k_t; }
+    if (k_t > 0.0) { xs = -f_t / k_t; }
     return vec2<f32>(f_t, xs);
 }
 
+// The spring-dashpot's coefficients of a contact (src/law/spring_dashpot.rs
+// `coefficients`): its pair's, times its effective mass in the material form.
 fn spring_dashpot(c: ContactInput) -> ContactOutput {
-    let f_el = elastic_force(c.delta);
-    let f_diss = dissipative_force(c.delta, c.delta_dot);
+    var m = 1.0;
+    if (params.per_mass != 0u) { m = c.m_eff; }
+    let k = params.pair_law[2u * c.pair] * m;
+    let mu = params.pair_law[2u * c.pair + 1u].x;
+    let f_el = elastic_force(k.x, c.delta);
+    let f_diss = dissipative_force(k.y, c.delta, c.delta_dot);
     var f_n = f_el + f_diss;
     if (params.clamp != 0u) { f_n = max(f_n, 0.0); }
-    let t = coulomb_spring(c.history, c.v_t, c.dt, f_n);
-    let energy = elastic_energy(c.delta) + 0.5 * params.k_t * t.y * t.y;
+    let t = coulomb_spring_with(c.history, c.v_t, c.dt, f_n, k.z, k.w, mu);
+    let energy = elastic_energy(k.x, c.delta) + 0.5 * k.z * t.y * t.y;
     return ContactOutput(f_n, t.x, t.y, energy);
 }
 

@@ -55,6 +55,8 @@ pub struct StepState<'a> {
     pub corners: &'a RotatedCorners,
     pub walls: &'a [WallSegment],
     pub dt: f64,
+    /// The side of the material form's pair table (src/law/restitution.rs); 0 without.
+    pub pair_side: usize,
 }
 
 /// Stage: the velocity (vx, vz, ω) = q1/dt of every particle.
@@ -84,6 +86,7 @@ pub fn contact_forces(
         corners,
         walls,
         dt,
+        pair_side: law.pair_table().map_or(0, |t| t.side),
     };
     out.clear();
     history_out.clear();
@@ -615,6 +618,7 @@ fn disk_kinematics(
         let m12 = m1 * m2 / (m1 + m2);
         (m12, 2.0 * m12)
     };
+    let (m_eff, pair_slot) = material_pair(s, pair, m12);
     let input = ContactInput {
         delta: g.delta,
         r: g.r,
@@ -625,8 +629,33 @@ fn disk_kinematics(
         mass,
         history,
         dt: s.dt,
+        m_eff,
+        pair: pair_slot,
     };
     (g, input)
+}
+
+/// The material form's view of a contact (src/law/restitution.rs): its effective mass,
+/// a fixed partner or a wall infinitely heavy, and its slot in the pair table; (m12, 0)
+/// for the other laws, which do not read them.
+#[inline(always)]
+fn material_pair(s: &StepState, pair: Pair, m12: f64) -> (f64, u32) {
+    use crate::law::restitution::{PairTable, effective_mass};
+    if s.pair_side == 0 {
+        return (m12, 0);
+    }
+    let p = s.particles;
+    let i = pair.i as usize;
+    if pair.is_wall() {
+        let slot = PairTable::slot(s.pair_side, p.material[i], s.pair_side as u32 - 1);
+        return (effective_mass(p.mass[i], p.fixed[i], None), slot);
+    }
+    let j = pair.j as usize;
+    let m_eff = effective_mass(p.mass[i], p.fixed[i], Some((p.mass[j], p.fixed[j])));
+    (
+        m_eff,
+        PairTable::slot(s.pair_side, p.material[i], p.material[j]),
+    )
 }
 
 /// Velocity of particle j's material at the contact point (zero for a wall), and its
@@ -722,6 +751,7 @@ fn area_kinematics(
         mass: 2.0 * m12,
         history,
         dt,
+        ..Default::default()
     };
     let g = Geometry {
         n: c.n,

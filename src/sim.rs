@@ -166,8 +166,7 @@ impl Simulation {
         step: u64,
         lost: u64,
     ) -> Result<Self, SceneError> {
-        let g = scene.gravity.g;
-        let law = ContactLaw::from_spec(&scene.contact, (g[0] * g[0] + g[1] * g[1]).sqrt())?;
+        let law = ContactLaw::of_scene(&scene)?;
         let copies = scene.replicas as usize;
         if sources.len() != copies * source_count(&scene) {
             return Err(SceneError::invalid(
@@ -395,6 +394,7 @@ impl Simulation {
             corners: &self.corners,
             walls: &self.walls,
             dt: self.scene.dt,
+            pair_side: self.law.pair_table().map_or(0, |t| t.side),
         };
         candidate_forces(
             &state,

@@ -174,26 +174,157 @@ fn missing_material_is_named() {
 #[test]
 fn time_step_too_large_for_the_stiffness() {
     assert_rejected(&["check", "--set", "dt=0.05"], &["dt", "t_c"]);
-    // a stiffer spring makes the default dt too large as well
-    assert_rejected(&["check", "--set", "contact.k_n=1e7"], &["dt", "too large"]);
+    // a shorter contact (a stiffer spring) makes the default dt too large as well
+    assert_rejected(
+        &["check", "--set", "contact.contact_time=0.005"],
+        &["dt", "too large"],
+    );
+    assert_rejected(
+        &[
+            "check",
+            "--set",
+            r#"contact={"law": "spring_dashpot", "k_n": 1e7}"#,
+        ],
+        &["dt", "too large"],
+    );
     // a mildly large dt only warns
     let (code, _, err) = talus(&["check", "--set", "dt=0.006"]);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("warning") && err.contains("t_c/10"), "{err}");
 }
 
+/// Issue 20: the material form (restitution and contact time) is checked like any input:
+/// each mistake names its key.
+#[test]
+fn the_material_form_refuses_what_does_not_belong() {
+    let set = |contact: &str| {
+        vec![
+            "check".to_string(),
+            "--set".into(),
+            format!("contact={contact}"),
+        ]
+    };
+    let cases: [(&str, &[&str]); 9] = [
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.75}"#,
+            &["contact.contact_time", "required"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.08, "k_n": 100}"#,
+            &["contact.k_n", "stiffness form"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.1, "contact_time": 0.08}"#,
+            &["contact.restitution", "0.1353", "clamp"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 1.2, "contact_time": 0.08, "clamp": false}"#,
+            &["contact.restitution", "(0, 1]"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": -1}"#,
+            &["contact.contact_time", "positive"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.08, "nu": 1.5}"#,
+            &["contact.restitution", "linear law"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.08, "pairs": [{"materials": ["grain", "sand"]}]}"#,
+            &["contact.pairs[0].materials", "sand", "walls"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.08, "pairs": [{"materials": ["grain", "walls"]}, {"materials": ["walls", "grain"]}]}"#,
+            &["contact.pairs[1].materials", "twice"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "k_n": 2000, "pairs": [{"materials": ["grain", "walls"]}]}"#,
+            &["contact.pairs", "material form"],
+        ),
+    ];
+    for (contact, mention) in cases {
+        let args = set(contact);
+        let args: Vec<&str> = args.iter().map(|s| s.as_str()).collect();
+        assert_rejected(&args, mention);
+    }
+}
+
+/// Issue 20: `talus check` prints what the contact law gives per pair of materials, and
+/// the run's scene.json records the resolved coefficients.
+#[test]
+fn check_prints_the_resolved_pairs_and_the_run_records_them() {
+    let (code, out, err) = talus(&["check"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(out.contains("material form"), "{out}");
+    assert!(out.contains("grain–grain: e 0.750, t_c 5.000e-2"), "{out}");
+    assert!(out.contains("grain–walls"), "{out}");
+    // The stiffness form says what restitution its absolute damping gives each kind of
+    // partner (not the same on a fixed one: the reason for the material form).
+    let (_, out, _) = talus(&[
+        "check",
+        "--set",
+        r#"contact={"law": "spring_dashpot", "k_n": 2000, "gamma_n": 10}"#,
+    ]);
+    assert!(out.contains("two moving (m_eff 0.5000): e 0.636"), "{out}");
+    assert!(
+        out.contains("on a fixed grain (m_eff 1.0000): e 0.720"),
+        "{out}"
+    );
+    let dir = tmp("resolved");
+    let (code, _, err) = talus(&[
+        "run",
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        "stop.time=0.1",
+        "--set",
+        "stop.kinetic_fraction=null",
+        "--set",
+        r#"contact.pairs=[{"materials": ["grain", "walls"], "restitution": 0.5}]"#,
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let scene: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("scene.json")).unwrap()).unwrap();
+    let resolved = scene["contact"]["resolved"]
+        .as_array()
+        .expect("contact.resolved");
+    assert_eq!(
+        resolved.len(),
+        2,
+        "grain–grain and grain–walls: {resolved:?}"
+    );
+    let walls = &resolved[1];
+    assert_eq!(walls["materials"], serde_json::json!(["grain", "walls"]));
+    assert!((walls["restitution"].as_f64().unwrap() - 0.5).abs() < 1e-12);
+    assert!((walls["contact_time"].as_f64().unwrap() - 0.05).abs() < 1e-12);
+    let (kappa, c) = talus::law::restitution::per_mass(0.5, 0.05, true).unwrap();
+    assert_eq!(walls["k_n_per_mass"].as_f64().unwrap(), kappa);
+    assert_eq!(walls["gamma_n_per_mass"].as_f64().unwrap(), c);
+    // Read back (resume, sweeps), the record is recomputed, never an input.
+    let text = std::fs::read_to_string(dir.join("scene.json")).unwrap();
+    let again = talus::scene::parse(&text, &[]).expect("scene.json reads back");
+    assert_eq!(serde_json::to_value(&again).unwrap(), scene);
+}
+
 #[test]
 fn check_warns_when_resting_overlaps_are_below_the_gpu_resolution() {
     // Issue 19: the GPU path resolves overlaps to about a position unit (cell/2³⁰ ≈ 1e-9
     // d), so resting overlaps below ~1e-6 d get forces off by more than 1e-3 there. The
-    // default heap at k_n = 1e9 rests at ~8e-10 d: a warning, not an error.
-    let (code, _, err) = talus(&["check", "--set", "contact.k_n=1e9", "--set", "dt=5e-6"]);
+    // default heap with contacts of 7e-5 (k_n/m ≈ 2e9) rests at ~5e-10 d: a warning, not
+    // an error.
+    let (code, _, err) = talus(&[
+        "check",
+        "--set",
+        "contact.contact_time=7e-5",
+        "--set",
+        "dt=5e-6",
+    ]);
     assert_eq!(code, 0, "{err}");
     assert!(
         err.contains("warning") && err.contains("GPU path resolves overlaps"),
         "{err}"
     );
-    // At its own k_n = 2000 it rests at ~4e-4 d: no such warning.
+    // At its own contact time (k_n/m ≈ 4e3) it rests at ~2.5e-4 d: no such warning.
     let (_, _, err) = talus(&["check"]);
     assert!(!err.contains("GPU path resolves"), "{err}");
 }

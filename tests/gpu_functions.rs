@@ -28,7 +28,9 @@ fn law(contact: serde_json::Value) -> ContactLaw {
 /// kernels' geometry gives them; `tail`: also separations up to 2 % of σ, the
 /// continuous laws' range), rates and tangential velocities of ±1, springs of ±10⁻³.
 /// `area`: the overlap-area law's δ = A/l and depth A/L.
-fn inputs(n: usize, area: bool, tail: bool, seed: u64) -> Vec<ContactInput> {
+/// `slots`: how many slots the law's pair table has (1 without one: the kernels then
+/// always pass slot 0).
+fn inputs(n: usize, area: bool, tail: bool, slots: u32, seed: u64) -> Vec<ContactInput> {
     let mut rng = Rng::new(seed);
     let f = |x: f64| x as f32 as f64;
     (0..n)
@@ -51,6 +53,8 @@ fn inputs(n: usize, area: bool, tail: bool, seed: u64) -> Vec<ContactInput> {
                 mass: f(2.0 * m12),
                 history: f(rng.range(-1e-3, 1e-3)),
                 dt: f(1e-4),
+                m_eff: f(rng.range(0.2, 1.0)),
+                pair: (rng.range(0.0, slots as f64) as u32).min(slots - 1),
             }
         })
         .collect()
@@ -62,6 +66,13 @@ fn wgsl_laws_match_their_rust_twins() {
         (
             "linear spring-dashpot",
             json!({ "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 5.0, "k_t": 500.0, "gamma_t": 1.0, "mu": 0.5 }),
+            1e-5,
+        ),
+        (
+            "material form, a pair of its own",
+            json!({ "law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.05,
+                    "gamma_t_ratio": 0.3, "mu": 0.5,
+                    "pairs": [{ "materials": ["m", "walls"], "restitution": 0.4, "mu": 0.8 }] }),
             1e-5,
         ),
         (
@@ -93,13 +104,18 @@ fn wgsl_laws_match_their_rust_twins() {
         let mut params = Params::default();
         talus::gpu::law_params(&law, &mut params);
         let tail = matches!(law, ContactLaw::Continuous(_));
-        let cases = inputs(4096, area, tail, 11);
+        let slots = talus::gpu::gpu_pair_side(&law).unwrap().pow(2) as u32;
+        let cases = inputs(4096, area, tail, slots, 11);
         let words: Vec<[u32; 4]> = (cases.iter())
             .flat_map(|c| {
                 [
                     word([c.delta, c.r, c.sigma, c.delta_dot]),
                     word([c.v_t, c.m12, c.mass, c.history]),
-                    word([c.dt, 0.0, 0.0, 0.0]),
+                    {
+                        let mut w = word([c.dt, c.m_eff, 0.0, 0.0]);
+                        w[2] = c.pair;
+                        w
+                    },
                 ]
             })
             .collect();
@@ -107,7 +123,7 @@ fn wgsl_laws_match_their_rust_twins() {
     let a = bitcast<vec4<f32>>(wgsl_arg(k, 0u));
     let b = bitcast<vec4<f32>>(wgsl_arg(k, 1u));
     let c = bitcast<vec4<f32>>(wgsl_arg(k, 2u));
-    let r = evaluate(ContactInput(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x));
+    let r = evaluate(ContactInput(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, c.y, bitcast<u32>(c.z)));
     wgsl_put(k, 0u, bitcast<vec4<u32>>(vec4<f32>(r.f_n, r.f_t, r.history, r.energy)));";
         let Some(out) = run_wgsl_fn(name, &[COMMON, LAWS], &params, (3, 1), body, &words) else {
             return;

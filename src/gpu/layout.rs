@@ -66,7 +66,7 @@ pub mod control {
 }
 
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Params {
     pub n_cap: u32,
     pub nx: u32,
@@ -119,6 +119,27 @@ pub struct Params {
     pub d_c: f32,
     /// `limits.max_step_displacement`² (0: no bound).
     pub max_step2: f32,
+    /// The spring-dashpot law's coefficients per pair of materials (src/law/restitution.rs):
+    /// the table's side (1: one entry for every contact) and whether they are per unit
+    /// of the contact's effective mass (the material form) or absolute.
+    pub pair_side: u32,
+    pub per_mass: u32,
+    pub pad_pair0: u32,
+    pub pad_pair1: u32,
+    pub pad_pair2: u32,
+    /// Slot s = a · pair_side + b of materials a and b (b = pair_side − 1: a wall):
+    /// `pair_law[2s]` = (k_n, γ_n, k_t, γ_t), `pair_law[2s + 1].x` = μ.
+    pub pair_law: [[f32; 4]; 2 * MAX_PAIR_SLOTS],
+}
+
+/// The most slots of the pair table the GPU path holds: 7 materials and the walls.
+pub const MAX_PAIR_SLOTS: usize = 64;
+
+impl Default for Params {
+    // `Default` is not derived for arrays longer than 32.
+    fn default() -> Self {
+        bytemuck::Zeroable::zeroed()
+    }
 }
 
 /// Dynamic state of one particle: q[0] = (rem_x, rem_z, rem_θ, 0) and the scaled Gear
@@ -306,7 +327,13 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 list_cap,
                 bond_g,
                 d_c,
-                max_step2
+                max_step2,
+                pair_side,
+                per_mass,
+                pad_pair0,
+                pad_pair1,
+                pad_pair2,
+                pair_law
             ]
         ),
         fields!(

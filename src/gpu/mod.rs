@@ -39,7 +39,7 @@ mod transfer;
 pub use buckets::{HASH_MIX_1, HASH_MIX_2, HASH_X, HASH_Z, MAX_BUCKETS, bucket, bucket_count};
 use buffers::{Buffers, Initial};
 use insert::{LayeredBase, SourceBase};
-pub use params::law_params;
+pub use params::{gpu_pair_side, law_params};
 pub use step::{BATCHES_IN_FLIGHT, Counters, REBUILD_STAGES, STEPS_PER_SUBMIT, workgroups};
 use step::{dispatch_args, initial_control};
 pub use transfer::{build_table, corner_starts, from_device, table_lookup, to_device};
@@ -284,6 +284,13 @@ impl GpuSimulation {
         if sim.scene.materials.len() > field || sim.scene.replicas as usize > field {
             return Err(GpuError::Unsupported(format!(
                 "the GPU path holds at most {field} materials and {field} copies of a scene"
+            )));
+        }
+        if params::gpu_pair_side(&sim.law).is_none() {
+            return Err(GpuError::Unsupported(format!(
+                "the GPU path holds contact.pairs for at most {} materials (and the walls); the scene has {}",
+                layout::MAX_PAIR_SLOTS.isqrt() - 1,
+                sim.scene.materials.len()
             )));
         }
         let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);

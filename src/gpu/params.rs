@@ -17,6 +17,7 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             p.gamma_t = l.gamma_t as f32;
             p.mu = l.mu as f32;
             p.clamp = l.clamp as u32;
+            pair_law(l, p);
         }
         ContactLaw::OverlapArea(l) => {
             // η^n and η^t travel in gamma_n and gamma_t (common.wgsl).
@@ -56,6 +57,59 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             p.alpha = c.alpha as f32;
             p.damping_fraction = c.damping_fraction as f32;
             p.g_scale = c.g as f32;
+        }
+    }
+}
+
+/// The side of the pair table the GPU holds for a law: 1 when every pair has the same
+/// coefficients (the stiffness form, or the material form without `pairs`), else the
+/// materials and the walls; None when it is larger than the GPU's table.
+pub fn gpu_pair_side(law: &ContactLaw) -> Option<usize> {
+    let side = match law.pair_table() {
+        Some(t) if t.coeffs.iter().any(|c| *c != t.coeffs[0]) => t.side,
+        _ => 1,
+    };
+    (side * side <= MAX_PAIR_SLOTS).then_some(side)
+}
+
+/// The spring-dashpot law's coefficients into `Params.pair_law`.
+fn pair_law(l: &crate::law::spring_dashpot::SpringDashpot, p: &mut Params) {
+    let law = ContactLaw::SpringDashpot(l.clone());
+    let side = gpu_pair_side(&law).expect("checked when the run was set up (GpuSimulation)");
+    p.pair_side = side as u32;
+    let entry = |c: &crate::law::restitution::PerMass| {
+        [
+            [
+                c.k_n as f32,
+                c.gamma_n as f32,
+                c.k_t as f32,
+                c.gamma_t as f32,
+            ],
+            [c.mu as f32, 0.0, 0.0, 0.0],
+        ]
+    };
+    match &l.pairs {
+        None => {
+            p.per_mass = 0;
+            let [a, b] = entry(&crate::law::restitution::PerMass {
+                k_n: l.k_n,
+                gamma_n: l.gamma_n,
+                k_t: l.k_t,
+                gamma_t: l.gamma_t,
+                mu: l.mu,
+            });
+            (p.pair_law[0], p.pair_law[1]) = (a, b);
+        }
+        Some(t) => {
+            p.per_mass = 1;
+            for a in 0..side {
+                for b in 0..side {
+                    // With one slot (side 1) every pair has the first pair's values.
+                    let [x, y] = entry(&t.coeffs[a * t.side + b]);
+                    let s = a * side + b;
+                    (p.pair_law[2 * s], p.pair_law[2 * s + 1]) = (x, y);
+                }
+            }
         }
     }
 }

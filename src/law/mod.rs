@@ -9,6 +9,7 @@
 pub mod continuous;
 pub mod hertz_cohesive;
 pub mod overlap_area;
+pub mod restitution;
 pub mod spring_dashpot;
 pub mod tangential;
 
@@ -36,6 +37,11 @@ pub struct ContactInput {
     /// Tangential history (spring ξ or paper 001's δ_F) from the previous step.
     pub history: f64,
     pub dt: f64,
+    /// The material form (src/law/restitution.rs): the reduced mass with a fixed partner
+    /// or a wall counted as infinitely heavy, and the pair of materials' slot in the
+    /// law's table. Other laws ignore them.
+    pub m_eff: f64,
+    pub pair: u32,
 }
 
 /// What a law returns for one contact: forces on particle 1 along n and t.
@@ -105,10 +111,11 @@ pub enum ContactLaw {
 impl ContactLaw {
     /// Turns the scene's contact block into coefficients, checking each parameter.
     /// `g` is |gravity|, the default force scale of the continuous laws.
-    pub fn from_spec(spec: &ContactSpec, g: f64) -> Result<Self, SceneError> {
+    /// `materials`: the scene's material names in index order.
+    pub fn from_spec(spec: &ContactSpec, g: f64, materials: &[String]) -> Result<Self, SceneError> {
         match spec {
             ContactSpec::SpringDashpot(s) => Ok(Self::SpringDashpot(
-                spring_dashpot::SpringDashpot::from_spec(s)?,
+                spring_dashpot::SpringDashpot::from_spec(s, materials)?,
             )),
             ContactSpec::OverlapArea(s) => {
                 Ok(Self::OverlapArea(overlap_area::OverlapArea::from_spec(s)?))
@@ -122,6 +129,25 @@ impl ContactLaw {
             ContactSpec::HertzCohesive(s) => Ok(Self::HertzCohesive(
                 hertz_cohesive::HertzCohesive::from_spec(s, g)?,
             )),
+        }
+    }
+
+    /// The contact law of a scene.
+    pub fn of_scene(scene: &crate::scene::Scene) -> Result<Self, SceneError> {
+        let g = scene.gravity.g;
+        let materials: Vec<String> = scene.materials.keys().cloned().collect();
+        Self::from_spec(
+            &scene.contact,
+            (g[0] * g[0] + g[1] * g[1]).sqrt(),
+            &materials,
+        )
+    }
+
+    /// The material form's pair table, if the law has one.
+    pub fn pair_table(&self) -> Option<&restitution::PairTable> {
+        match self {
+            Self::SpringDashpot(l) => l.pairs.as_ref(),
+            _ => None,
         }
     }
 

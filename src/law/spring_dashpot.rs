@@ -1,8 +1,9 @@
 //! Power-law spring-dashpot for disks, paper 000 eq. 2–5 (SPEC 2.1).
 
+use super::restitution::{PairTable, PerMass};
 use super::tangential::{coulomb_spring, spring_energy};
 use super::{ContactInput, ContactOutput, clamp_non_negative};
-use crate::scene::{SceneError, SpringDashpotSpec};
+use crate::scene::{ResolvedPair, SceneError, SpringDashpotSpec, WALLS};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpringDashpot {
@@ -15,15 +16,45 @@ pub struct SpringDashpot {
     pub gamma_t: f64,
     pub mu: f64,
     pub clamp: bool,
+    /// The material form (`restitution` and `contact_time`): coefficients per pair of
+    /// materials per unit of the contact's reduced mass (src/law/restitution.rs); the
+    /// absolute ones above are then unused. None: the stiffness form.
+    pub pairs: Option<PairTable>,
 }
+
+/// k_t/k_n of the material form when the scene does not say (the ratio of a
+/// homogeneous elastic disk's tangential and normal stiffness, as in paper 000).
+pub const DEFAULT_KT_RATIO: f64 = 2.0 / 7.0;
 
 /// Reference overlap, as a fraction of the diameter, at which the stiffness of a
 /// nonlinear (ν ≠ 1) law is taken for the time-step check: a large overlap for DEM.
 pub const REFERENCE_OVERLAP: f64 = 0.05;
 
 impl SpringDashpot {
-    pub fn from_spec(s: &SpringDashpotSpec) -> Result<Self, SceneError> {
-        positive("contact.k_n", s.k_n)?;
+    /// `materials`: the scene's material names in index order (the pair table's rows).
+    pub fn from_spec(s: &SpringDashpotSpec, materials: &[String]) -> Result<Self, SceneError> {
+        if s.restitution.is_some() || s.contact_time.is_some() {
+            return Self::from_material_form(s, materials);
+        }
+        for (key, given) in [
+            ("kt_ratio", s.kt_ratio.is_some()),
+            ("gamma_t_ratio", s.gamma_t_ratio.is_some()),
+            ("pairs", !s.pairs.is_empty()),
+        ] {
+            if given {
+                return Err(SceneError::invalid(
+                    format!("contact.{key}"),
+                    "belongs to the material form: give restitution and contact_time instead of k_n",
+                ));
+            }
+        }
+        let Some(k_n) = s.k_n else {
+            return Err(SceneError::invalid(
+                "contact.k_n",
+                "is required (or give restitution and contact_time, the material form)",
+            ));
+        };
+        positive("contact.k_n", k_n)?;
         if !(s.nu >= 1.0 && s.nu <= 3.0) {
             return Err(SceneError::invalid(
                 "contact.nu",
@@ -54,7 +85,7 @@ impl SpringDashpot {
         non_negative("contact.gamma_t", s.gamma_t)?;
         non_negative("contact.mu", s.mu)?;
         Ok(Self {
-            k_n: s.k_n,
+            k_n,
             nu: s.nu,
             psi: s.psi,
             delta0,
@@ -63,22 +94,200 @@ impl SpringDashpot {
             gamma_t: s.gamma_t,
             mu: s.mu,
             clamp: s.clamp,
+            pairs: None,
         })
+    }
+
+    /// The material form: e and t_c (and μ) for every pair of materials, resolved into
+    /// coefficients per unit of reduced mass (src/law/restitution.rs).
+    fn from_material_form(s: &SpringDashpotSpec, materials: &[String]) -> Result<Self, SceneError> {
+        let (Some(e), Some(t_c)) = (s.restitution, s.contact_time) else {
+            let missing = if s.restitution.is_none() {
+                "restitution"
+            } else {
+                "contact_time"
+            };
+            return Err(SceneError::invalid(
+                format!("contact.{missing}"),
+                "is required with the other of restitution and contact_time (the material form)",
+            ));
+        };
+        for (key, given) in [
+            ("k_n", s.k_n.is_some()),
+            ("gamma_n", s.gamma_n != 0.0),
+            ("k_t", s.k_t != 0.0),
+            ("gamma_t", s.gamma_t != 0.0),
+            ("delta0", s.delta0.is_some()),
+        ] {
+            if given {
+                return Err(SceneError::invalid(
+                    format!("contact.{key}"),
+                    "belongs to the stiffness form: with restitution and contact_time the law resolves it (use kt_ratio and gamma_t_ratio for the tangential spring)",
+                ));
+            }
+        }
+        if s.nu != 1.0 || s.psi != 0.0 {
+            return Err(SceneError::invalid(
+                "contact.restitution",
+                format!(
+                    "the material form is the linear law only (nu = 1, psi = 0; got nu = {}, psi = {}): give k_n and gamma_n for a nonlinear law",
+                    s.nu, s.psi
+                ),
+            ));
+        }
+        let kt_ratio = non_negative("contact.kt_ratio", s.kt_ratio.unwrap_or(DEFAULT_KT_RATIO))?;
+        let gt_ratio = non_negative("contact.gamma_t_ratio", s.gamma_t_ratio.unwrap_or(0.0))?;
+        let mu = non_negative("contact.mu", s.mu)?;
+        let resolve = |at: &str, e: f64, t_c: f64, mu: f64| -> Result<PerMass, SceneError> {
+            positive(&format!("{at}.contact_time"), t_c)?;
+            let Some((k_n, gamma_n)) = super::restitution::per_mass(e, t_c, s.clamp) else {
+                let range = if s.clamp {
+                    format!(
+                        "in ({:.4}, 1] under the clamp f_n ≥ 0 (set clamp: false for less)",
+                        super::restitution::CLAMPED_MIN_RESTITUTION
+                    )
+                } else {
+                    "in (0, 1]".to_string()
+                };
+                return Err(SceneError::invalid(
+                    format!("{at}.restitution"),
+                    format!("must be {range}, got {e}"),
+                ));
+            };
+            Ok(PerMass {
+                k_n,
+                gamma_n,
+                k_t: kt_ratio * k_n,
+                gamma_t: gt_ratio * gamma_n,
+                mu,
+            })
+        };
+        if !s.pairs.is_empty() && materials.iter().any(|m| m == WALLS) {
+            return Err(SceneError::invalid(
+                format!("materials.{WALLS}"),
+                format!(
+                    "\"{WALLS}\" names the wall segments in contact.pairs: rename the material"
+                ),
+            ));
+        }
+        let base = resolve("contact", e, t_c, mu)?;
+        let side = materials.len() + 1;
+        let mut coeffs = vec![base; side * side];
+        let mut seen = std::collections::BTreeSet::new();
+        for (k, p) in s.pairs.iter().enumerate() {
+            let at = format!("contact.pairs[{k}]");
+            let index = |name: &str| -> Result<usize, SceneError> {
+                if name == WALLS {
+                    return Ok(side - 1);
+                }
+                materials.iter().position(|m| m == name).ok_or_else(|| {
+                    SceneError::invalid(
+                        format!("{at}.materials"),
+                        format!(
+                            "unknown material \"{name}\" (known: {}, and \"{WALLS}\")",
+                            materials.join(", ")
+                        ),
+                    )
+                })
+            };
+            let (a, b) = (index(&p.materials[0])?, index(&p.materials[1])?);
+            if a == side - 1 && b == side - 1 {
+                return Err(SceneError::invalid(
+                    format!("{at}.materials"),
+                    "walls do not touch walls",
+                ));
+            }
+            if !seen.insert((a.min(b), a.max(b))) {
+                return Err(SceneError::invalid(
+                    format!("{at}.materials"),
+                    "this pair is listed twice",
+                ));
+            }
+            let mu = non_negative(&format!("{at}.mu"), p.mu.unwrap_or(mu))?;
+            let c = resolve(
+                &at,
+                p.restitution.unwrap_or(e),
+                p.contact_time.unwrap_or(t_c),
+                mu,
+            )?;
+            coeffs[a * side + b] = c;
+            coeffs[b * side + a] = c;
+        }
+        Ok(Self {
+            k_n: base.k_n,
+            nu: 1.0,
+            psi: 0.0,
+            delta0: 1.0,
+            gamma_n: base.gamma_n,
+            k_t: base.k_t,
+            gamma_t: base.gamma_t,
+            mu,
+            clamp: s.clamp,
+            pairs: Some(PairTable { side, coeffs }),
+        })
+    }
+
+    /// The material form's table as the scene records it (`contact.resolved`): each
+    /// unordered pair once, walls last.
+    pub fn resolved(&self, materials: &[String]) -> Vec<ResolvedPair> {
+        let Some(t) = &self.pairs else {
+            return Vec::new();
+        };
+        let name = |k: usize| {
+            materials
+                .get(k)
+                .cloned()
+                .unwrap_or_else(|| WALLS.to_string())
+        };
+        let mut out = Vec::new();
+        for a in 0..t.side {
+            for b in a..t.side {
+                if a == t.side - 1 {
+                    continue;
+                }
+                let c = t.coeffs[a * t.side + b];
+                let (e, t_c) = super::restitution::collision(c.k_n, c.gamma_n, self.clamp)
+                    .unwrap_or((f64::NAN, f64::NAN));
+                out.push(ResolvedPair {
+                    materials: [name(a), name(b)],
+                    restitution: e,
+                    contact_time: t_c,
+                    mu: c.mu,
+                    k_n_per_mass: c.k_n,
+                    gamma_n_per_mass: c.gamma_n,
+                    k_t_per_mass: c.k_t,
+                    gamma_t_per_mass: c.gamma_t,
+                });
+            }
+        }
+        out
+    }
+
+    /// The coefficients of one contact: (k_n, γ_n, k_t, γ_t, μ).
+    #[inline(always)]
+    fn coefficients(&self, c: &ContactInput) -> (f64, f64, f64, f64, f64) {
+        match &self.pairs {
+            None => (self.k_n, self.gamma_n, self.k_t, self.gamma_t, self.mu),
+            Some(t) => {
+                let p = t.get(c.pair);
+                let m = c.m_eff;
+                (p.k_n * m, p.gamma_n * m, p.k_t * m, p.gamma_t * m, p.mu)
+            }
+        }
     }
 
     #[inline(always)]
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
-        let f_el = elastic_force(self.k_n, self.delta0, self.nu, c.delta);
-        let f_diss = dissipative_force(self.gamma_n, self.delta0, self.psi, c.delta, c.delta_dot);
+        let (k_n, gamma_n, k_t, gamma_t, mu) = self.coefficients(c);
+        let f_el = elastic_force(k_n, self.delta0, self.nu, c.delta);
+        let f_diss = dissipative_force(gamma_n, self.delta0, self.psi, c.delta, c.delta_dot);
         let f_n = if self.clamp {
             clamp_non_negative(f_el + f_diss)
         } else {
             f_el + f_diss
         };
-        let (f_t, xi) =
-            coulomb_spring(c.history, c.v_t, c.dt, self.k_t, self.gamma_t, self.mu, f_n);
-        let energy =
-            elastic_energy(self.k_n, self.delta0, self.nu, c.delta) + spring_energy(self.k_t, xi);
+        let (f_t, xi) = coulomb_spring(c.history, c.v_t, c.dt, k_t, gamma_t, mu, f_n);
+        let energy = elastic_energy(k_n, self.delta0, self.nu, c.delta) + spring_energy(k_t, xi);
         ContactOutput {
             f_n,
             f_t,
@@ -89,7 +298,12 @@ impl SpringDashpot {
 
     /// ω0² = k/m12 with k the stiffness dF/dδ: k_n for ν = 1, else taken at an overlap of
     /// [`REFERENCE_OVERLAP`] of the diameter σ.
+    /// In the material form ω0² is the pair's k_n per unit mass, whatever the masses:
+    /// the stiffest pair's.
     pub fn omega0_squared(&self, m12: f64, sigma: f64) -> f64 {
+        if let Some(t) = &self.pairs {
+            return t.coeffs.iter().map(|c| c.k_n).fold(0.0, f64::max);
+        }
         let k = if self.nu == 1.0 {
             self.k_n
         } else {
@@ -177,6 +391,7 @@ mod tests {
             gamma_t: 0.0,
             mu: 0.0,
             clamp: true,
+            pairs: None,
         };
         let c = ContactInput {
             delta: 0.01,

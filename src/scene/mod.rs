@@ -14,7 +14,7 @@ pub use overrides::apply_override;
 pub use schema::*;
 pub use validate::{
     max_diameter, polygon_of, reach_bound_of, shortest_contact_time, smallest_particle_area,
-    validate,
+    typical_masses, validate,
 };
 
 /// Non-fatal remarks about a valid scene (e.g. dt above t_c/10).
@@ -62,9 +62,24 @@ pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
     for o in overrides {
         apply_override(&mut value, o)?;
     }
-    let scene = from_value(value)?;
+    let mut scene = from_value(value)?;
     validate(&scene)?;
+    resolve_materials(&mut scene)?;
     Ok(scene)
+}
+
+/// Records what the material form resolved (`contact.resolved`, src/law/restitution.rs),
+/// so that the run's `scene.json` says which k and γ per unit mass each pair got. Never an
+/// input: a `resolved` block read back is replaced by the values computed anew.
+fn resolve_materials(scene: &mut Scene) -> Result<(), SceneError> {
+    let law = crate::law::ContactLaw::of_scene(scene)?;
+    if let (ContactSpec::SpringDashpot(spec), crate::law::ContactLaw::SpringDashpot(l)) =
+        (&mut scene.contact, &law)
+    {
+        let names: Vec<String> = scene.materials.keys().cloned().collect();
+        spec.resolved = l.resolved(&names);
+    }
+    Ok(())
 }
 
 /// Strict typed parse of a JSON value; errors carry the key path. An array where the
@@ -134,6 +149,7 @@ fn refine_tagged_error(root: &serde_json::Value, path: &str) -> Option<SceneErro
         let block = root.get("contact")?.clone();
         return match block.get("law")?.as_str()? {
             "spring_dashpot" => inner::<SpringDashpotSpec>(block, "law", path),
+            "overlap_area" => inner::<OverlapAreaSpec>(block, "law", path),
             "continuous" => inner::<ContinuousSpec>(block, "law", path),
             "hooke_equivalent" => inner::<HookeEquivalentSpec>(block, "law", path),
             "hertz_cohesive" => inner::<HertzCohesiveSpec>(block, "law", path),

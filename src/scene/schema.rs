@@ -189,8 +189,32 @@ pub struct RodSpec {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpringDashpotSpec {
-    /// Normal stiffness k_n (force/length for ν = 1).
-    pub k_n: f64,
+    /// Normal stiffness k_n (force/length for ν = 1). Either this (the stiffness form,
+    /// with `gamma_n`, `k_t`, `gamma_t`) or `restitution` with `contact_time` (the
+    /// material form, linear law only: src/law/restitution.rs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k_n: Option<f64>,
+    /// Coefficient of restitution of a head-on collision, the same for every pair of
+    /// particles (resolved per contact from its reduced mass, a fixed partner or a wall
+    /// counted as infinitely heavy).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+    /// How long the surfaces of a head-on collision overlap (time).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_time: Option<f64>,
+    /// Material form: k_t/k_n (default 2/7) and γ_t/γ_n (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kt_ratio: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gamma_t_ratio: Option<f64>,
+    /// Material form: other values for some pairs of materials (`"walls"` names the wall
+    /// segments); the rest take the block's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pairs: Vec<MaterialPair>,
+    /// Material form: what talus resolved for every pair, written into the run's
+    /// `scene.json` for the record; computed anew whenever a scene is read.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub resolved: Vec<ResolvedPair>,
     /// Elastic exponent ν: 1 Hooke, 1.5 Hertz, 2 conical.
     #[serde(default = "one")]
     pub nu: f64,
@@ -219,7 +243,38 @@ pub struct SpringDashpotSpec {
     pub clamp: bool,
 }
 
-/// Continuous r^-(n+1) interaction with tapered friction, paper 001 eq. 3–8.
+/// A pair of materials whose collisions differ from the contact block's (material form).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialPair {
+    /// Two material names; `"walls"` for the wall segments.
+    pub materials: [String; 2],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_time: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mu: Option<f64>,
+}
+
+/// One pair's resolved coefficients per unit of the contact's reduced mass m_eff: a
+/// contact of that pair has k_n = m_eff · `k_n_per_mass` and so on.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ResolvedPair {
+    pub materials: [String; 2],
+    pub restitution: f64,
+    pub contact_time: f64,
+    pub mu: f64,
+    pub k_n_per_mass: f64,
+    pub gamma_n_per_mass: f64,
+    pub k_t_per_mass: f64,
+    pub gamma_t_per_mass: f64,
+}
+
+/// The name that stands for the wall segments in `contact.pairs`.
+pub const WALLS: &str = "walls";
+
 /// The overlap-area law of convex polygons, paper 000 eq. 6–7 (SPEC 2.3).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -265,6 +320,7 @@ pub struct PolygonSpec {
     pub irregular: bool,
 }
 
+/// Continuous r^-(n+1) interaction with tapered friction, paper 001 eq. 3–8.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContinuousSpec {

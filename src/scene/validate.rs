@@ -221,6 +221,25 @@ pub fn smallest_particle_area(scene: &Scene) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// Each material's typical particle mass (None for a material no block creates): the
+/// mass of a disk of the middle diameter of each block's range, averaged over the
+/// material's blocks (`talus check`'s contact table).
+pub fn typical_masses(scene: &Scene) -> Vec<Option<f64>> {
+    (scene.materials.iter())
+        .map(|(name, m)| {
+            let masses: Vec<f64> = (scene.particles.iter())
+                .filter(|c| material_of(c) == name)
+                .map(|c| {
+                    let (lo, hi) = size_bounds(c);
+                    let d = 0.5 * (lo + hi);
+                    m.density * std::f64::consts::FRAC_PI_4 * d * d * m.thickness
+                })
+                .collect();
+            (!masses.is_empty()).then(|| masses.iter().sum::<f64>() / masses.len() as f64)
+        })
+        .collect()
+}
+
 fn material_of(c: &Creation) -> &str {
     match c {
         Creation::LatticePile(p) => &p.material,
@@ -631,8 +650,7 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
         finite_non_negative("skin", skin)?;
     }
 
-    let g = scene.gravity.g;
-    let law = ContactLaw::from_spec(&scene.contact, (g[0] * g[0] + g[1] * g[1]).sqrt())?;
+    let law = ContactLaw::of_scene(scene)?;
     spheropolygons(scene, &law)?;
     if let Some(tc) = shortest_contact_time(scene, &law) {
         if scene.dt > tc / MIN_STEPS_PER_CONTACT {
@@ -649,10 +667,23 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
             // A grain in a packing feels ~6 dashpots at once; explicit Gear goes unstable
             // (a limit cycle, then divergence) once 6 γ_n dt / m approaches 1. Measured on
             // the R1 pile: 0.25 oscillates forever, 0.08 settles.
-            let ratio = 6.0 * l.gamma_n * scene.dt / m;
+            // In the material form γ_n = m_eff · (γ_n/m) with m_eff ≤ m: the bound is
+            // 6 (γ_n/m) dt, the largest over the pairs.
+            let (ratio, what, fix) = match &l.pairs {
+                None => (
+                    6.0 * l.gamma_n * scene.dt / m,
+                    "6·gamma_n·dt/m",
+                    "contact.gamma_n",
+                ),
+                Some(t) => (
+                    6.0 * t.coeffs.iter().map(|c| c.gamma_n).fold(0.0, f64::max) * scene.dt,
+                    "6·(gamma_n/m_eff)·dt",
+                    "raise contact.restitution or contact.contact_time",
+                ),
+            };
             if ratio > DAMPING_STABILITY {
                 warnings.push(format!(
-                    "6·gamma_n·dt/m = {ratio:.2} for the lightest particle exceeds {DAMPING_STABILITY}: strong damping may make the integrator oscillate or diverge; reduce dt or contact.gamma_n"
+                    "{what} = {ratio:.2} for the lightest particle exceeds {DAMPING_STABILITY}: strong damping may make the integrator oscillate or diverge; reduce dt or {fix}"
                 ));
             }
         }

@@ -87,7 +87,6 @@ pub fn head_on_on(
     dt: f64,
     integrator: &str,
 ) -> Option<(f64, f64)> {
-    const CHUNK: u64 = 16;
     let mut v = scene_value(
         contact,
         json!([{ "kind": "list", "material": "m", "particles": [
@@ -97,14 +96,23 @@ pub fn head_on_on(
     );
     v["dt"] = json!(dt);
     v["integrator"] = json!(integrator);
+    head_on_scene(path, &v, v0, 1.0)
+}
+
+/// The head-on collision of any scene whose particles 0 and 1 lie on a horizontal line
+/// 0.002 apart, closing at relative speed `v0`, with radii summing to `reach` (particle 1
+/// may be fixed): (overlap time, restitution), as `head_on_on`.
+pub fn head_on_scene(path: Path, v: &Value, v0: f64, reach: f64) -> Option<(f64, f64)> {
+    const CHUNK: u64 = 16;
+    let dt = v["dt"].as_f64().expect("dt");
     let overlap = |e: &mut talus::run::Engine| {
         let p = e.positions();
         let r = (p[0][0] - p[1][0]).hypot(p[0][1] - p[1][1]);
-        (e.step() as f64 * dt, 1.0 - r)
+        (e.step() as f64 * dt, reach - r)
     };
     // The gap of 0.002 closes at v0: fly to just before it.
     let start = (0.95 * 0.002 / v0 / dt) as u64;
-    let mut e = engine(path, "head_on", sim(&v))?;
+    let mut e = engine(path, "head_on", sim(v))?;
     e.advance(start).expect("no divergence");
     assert!(overlap(&mut e).1 < 0.0, "still apart");
     // Pass 1: the chunks in which δ turns positive and back to 0 or below.
@@ -124,7 +132,7 @@ pub fn head_on_on(
     }
     let (chunk_in, chunk_out) = (chunk_in.expect("collided"), chunk_out.expect("separated"));
     // Pass 2: step by step through those chunks.
-    let mut e = engine(path, "head_on", sim(&v))?;
+    let mut e = engine(path, "head_on", sim(v))?;
     let crossing_in = |e: &mut talus::run::Engine, from: u64, inwards: bool| {
         e.advance(from - e.step()).expect("no divergence");
         let mut prev = overlap(e);

@@ -1,0 +1,273 @@
+//! Materials given as a restitution coefficient e and a contact time t_c instead of a
+//! stiffness and a damping (issue 20): the linear spring-dashpot's closed forms, and the
+//! table of coefficients per pair of materials.
+//!
+//! The head-on collision of the linear law, m δ̈ = −k δ − γ δ̇ with m the pair's reduced
+//! mass, depends on k and γ only through ω0² = k/m and β = γ/(2m) (paper 000 sec. 2.1).
+//! So the coefficients are resolved *per unit of reduced mass*, κ = k/m and c = γ/m, and
+//! each contact multiplies them by its own reduced mass m_eff (a fixed particle or a wall
+//! counted as infinitely heavy: m_eff is then the moving particle's mass). Every pair,
+//! moving or resting on the base, light or heavy, then collides with the e and t_c asked
+//! for; this is how LIGGGHTS resolves its `coefficientRestitution` per contact from the
+//! effective mass. The price: a heavier pair is stiffer (k ∝ m_eff).
+//!
+//! With δ(t) = (v0/ω) e^(−βt) sin ωt, ω² = ω0² − β², η = β/ω:
+//! - unclamped (the textbook law, `clamp: false`): the contact lasts t_c = π/ω and
+//!   e = exp(−η π);
+//! - clamped (SPEC 2's f_n ≥ 0, the default): the force k δ + γ δ̇ vanishes at ω t* = φ(η)
+//!   = π − 2 arctan η, where δ̇ = −v0 e^(−βt*), so e = exp(−η φ(η)) (Schwager & Pöschel,
+//!   Granular Matter 9, 465 (2007)); the disks then fly apart with δ(t*) = (v0/ω) e^(−βt*)
+//!   sin φ still to close, which takes sin φ / ω more. `contact_time` is the whole time
+//!   the surfaces overlap, t_c = (φ + sin φ)/ω: what the head-on test measures, and π/ω
+//!   again as η → 0. Under the clamp e > e^(−2) ≈ 0.135 (η → ∞).
+
+use std::f64::consts::PI;
+
+/// φ(η) = ω t*, the phase at which the clamped law's force vanishes.
+fn clamped_phase(eta: f64) -> f64 {
+    PI - 2.0 * eta.atan()
+}
+
+/// The smallest restitution the clamped linear law reaches (η → ∞): e^(−2).
+pub const CLAMPED_MIN_RESTITUTION: f64 = 0.135_335_283_236_612_7;
+
+/// η = β/ω of the linear law with restitution e; None when no damping gives it.
+pub fn eta_for(e: f64, clamp: bool) -> Option<f64> {
+    if !(e > 0.0 && e <= 1.0) {
+        return None;
+    }
+    let target = -e.ln();
+    if !clamp {
+        return Some(target / PI);
+    }
+    if e <= CLAMPED_MIN_RESTITUTION {
+        return None;
+    }
+    // η φ(η) rises monotonically from 0 to 2: bisect (60 halvings of a bracket that
+    // doubles until it holds the root give η to the last bits).
+    let f = |eta: f64| eta * clamped_phase(eta) - target;
+    let mut hi = 1.0;
+    while f(hi) < 0.0 {
+        hi *= 2.0;
+    }
+    let mut lo = 0.0;
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid) < 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= f64::EPSILON * hi {
+            break;
+        }
+    }
+    Some(0.5 * (lo + hi))
+}
+
+/// The restitution and overlap time of the linear law with ω0² = κ and β = c/2 (the
+/// inverse of [`per_mass`]); None when it does not bounce (β ≥ ω0).
+pub fn collision(kappa: f64, c: f64, clamp: bool) -> Option<(f64, f64)> {
+    let beta = 0.5 * c;
+    let w2 = kappa - beta * beta;
+    if !(w2 > 0.0) {
+        return None;
+    }
+    let omega = w2.sqrt();
+    let eta = beta / omega;
+    Some(if clamp {
+        let phi = clamped_phase(eta);
+        ((-eta * phi).exp(), (phi + phi.sin()) / omega)
+    } else {
+        ((-eta * PI).exp(), PI / omega)
+    })
+}
+
+/// The normal coefficients per unit of reduced mass, (κ = k_n/m, c = γ_n/m), that give
+/// restitution e and contact time t_c (module docs); None when e is out of reach.
+pub fn per_mass(e: f64, t_c: f64, clamp: bool) -> Option<(f64, f64)> {
+    let eta = eta_for(e, clamp)?;
+    let phase = if clamp {
+        let phi = clamped_phase(eta);
+        phi + phi.sin()
+    } else {
+        PI
+    };
+    let omega = phase / t_c;
+    let beta = eta * omega;
+    Some((omega * omega + beta * beta, 2.0 * beta))
+}
+
+/// One pair of materials' coefficients per unit of the contact's reduced mass.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PerMass {
+    /// k_n/m (1/time²), γ_n/m (1/time), k_t/m, γ_t/m.
+    pub k_n: f64,
+    pub gamma_n: f64,
+    pub k_t: f64,
+    pub gamma_t: f64,
+    pub mu: f64,
+}
+
+/// The coefficients of every pair of materials: `side` = materials + 1, the last row and
+/// column for the walls. Symmetric; a contact looks its pair up by [`PairTable::slot`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct PairTable {
+    pub side: usize,
+    pub coeffs: Vec<PerMass>,
+}
+
+impl PairTable {
+    /// The table's index of a contact between materials a and b (b = `side − 1`: a wall).
+    #[inline(always)]
+    pub fn slot(side: usize, a: u32, b: u32) -> u32 {
+        a * side as u32 + b
+    }
+
+    #[inline(always)]
+    pub fn get(&self, slot: u32) -> &PerMass {
+        &self.coeffs[slot as usize]
+    }
+
+    /// The index of the walls' row.
+    pub fn walls(&self) -> u32 {
+        self.side as u32 - 1
+    }
+}
+
+/// The effective mass of a contact: the reduced mass, with a fixed partner (or a wall,
+/// `j = None`) infinitely heavy.
+#[inline(always)]
+pub fn effective_mass(mi: f64, fixed_i: bool, j: Option<(f64, bool)>) -> f64 {
+    match j {
+        None => mi,
+        Some((_, true)) if !fixed_i => mi,
+        Some((mj, false)) if fixed_i => mj,
+        Some((mj, _)) => mi * mj / (mi + mj),
+    }
+}
+
+/// `talus check`'s table of the spring-dashpot law per pair of materials: the
+/// coefficients, and the restitution and contact time they give, for typical particles
+/// (`masses`, by material: `scene::typical_masses`) colliding with a moving one and with
+/// a fixed one or a wall (infinitely heavy).
+pub fn describe(
+    law: &super::spring_dashpot::SpringDashpot,
+    materials: &[String],
+    masses: &[Option<f64>],
+) -> Vec<String> {
+    let clamp = if law.clamp {
+        "clamped f_n ≥ 0"
+    } else {
+        "unclamped"
+    };
+    let mut out = Vec::new();
+    let linear = law.nu == 1.0 && law.psi == 0.0;
+    match &law.pairs {
+        Some(_) => out.push(format!(
+            "contact: material form ({clamp}): every contact has k = m_eff · k/m of its pair, m_eff its reduced mass (a fixed partner or a wall infinitely heavy)"
+        )),
+        None if linear => out.push(format!(
+            "contact: stiffness form ({clamp}): k_n = {}, γ_n = {}, k_t = {}, γ_t = {}, μ = {}; what they give:",
+            law.k_n, law.gamma_n, law.k_t, law.gamma_t, law.mu
+        )),
+        None => {
+            out.push(format!(
+                "contact: nonlinear spring-dashpot (ν = {}, ψ = {}): restitution and contact time depend on the impact speed, not tabulated",
+                law.nu, law.psi
+            ));
+            return out;
+        }
+    }
+    let side = materials.len() + 1;
+    let name = |k: usize| materials.get(k).map_or(crate::scene::WALLS, |s| s.as_str());
+    // One line per pair and per kind of partner: (m_eff, what it is).
+    let collide = |kappa: f64, c: f64| match collision(kappa, c, law.clamp) {
+        Some((e, t_c)) => format!("e {e:.3}, t_c {t_c:.3e}"),
+        None => "no bounce (overdamped)".to_string(),
+    };
+    for a in 0..materials.len() {
+        let Some(ma) = masses[a] else { continue };
+        for b in a..side {
+            let partners: Vec<(f64, String)> = if b == side - 1 {
+                vec![(ma, "a wall".to_string())]
+            } else {
+                let Some(mb) = masses[b] else { continue };
+                vec![
+                    (ma * mb / (ma + mb), "two moving".to_string()),
+                    (ma, format!("a moving {} on a fixed {}", name(a), name(b))),
+                ]
+            };
+            let pair = format!("  {}–{}:", name(a), name(b));
+            match &law.pairs {
+                Some(t) => {
+                    let p = t.coeffs[a * t.side + b];
+                    let mut line = format!(
+                        "{pair} {}, μ {}; per unit mass k_n {:.4e}, γ_n {:.4e}, k_t {:.4e}, γ_t {:.4e}",
+                        collide(p.k_n, p.gamma_n),
+                        p.mu,
+                        p.k_n,
+                        p.gamma_n,
+                        p.k_t,
+                        p.gamma_t
+                    );
+                    for (m, what) in partners {
+                        line += &format!(
+                            "; {what} (m_eff {m:.4}): k_n {:.4e}, γ_n {:.4e}",
+                            p.k_n * m,
+                            p.gamma_n * m
+                        );
+                    }
+                    out.push(line);
+                }
+                None => {
+                    let parts: Vec<String> = (partners.iter())
+                        .map(|(m, what)| {
+                            format!(
+                                "{what} (m_eff {m:.4}): {}",
+                                collide(law.k_n / m, law.gamma_n / m)
+                            )
+                        })
+                        .collect();
+                    out.push(format!("{pair} {}", parts.join("; ")));
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn per_mass_and_collision_are_inverse() {
+        for clamp in [false, true] {
+            for e in [0.2, 0.5, 0.6, 0.9, 0.999, 1.0] {
+                let (kappa, c) = per_mass(e, 0.05, clamp).unwrap();
+                let (e2, t2) = collision(kappa, c, clamp).unwrap();
+                assert!((e2 - e).abs() < 1e-12, "{clamp} {e}: {e2}");
+                assert!((t2 - 0.05).abs() < 1e-12, "{clamp} {e}: {t2}");
+            }
+        }
+    }
+
+    #[test]
+    fn clamped_restitution_has_a_floor() {
+        assert!(eta_for(0.13, true).is_none());
+        assert!(eta_for(0.14, true).is_some());
+        assert!(eta_for(0.13, false).is_some());
+        assert!(eta_for(0.0, false).is_none());
+        assert!(eta_for(1.5, false).is_none());
+        assert_eq!(CLAMPED_MIN_RESTITUTION, (-2.0f64).exp());
+    }
+
+    #[test]
+    fn effective_mass_counts_fixed_partners_as_infinitely_heavy() {
+        assert_eq!(effective_mass(2.0, false, None), 2.0);
+        assert_eq!(effective_mass(2.0, false, Some((2.0, false))), 1.0);
+        assert_eq!(effective_mass(2.0, false, Some((5.0, true))), 2.0);
+        assert_eq!(effective_mass(2.0, true, Some((3.0, false))), 3.0);
+    }
+}
