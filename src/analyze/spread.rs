@@ -422,20 +422,20 @@ mod tests {
     #[test]
     fn a_clear_m_is_called_m_and_a_plain_heap_is_not() {
         let mut m_calls = 0;
-        let mut flat_calls = 0;
+        let mut hump_calls = 0;
         for seed in 0..20 {
             let (m, _) = base_dip(&heap_loads(true, 0.15, seed), 40, 5, 400, SEED);
             assert!(m.dip > 0.0, "seed {seed}: {m:?}");
             m_calls += (m.verdict == "M") as usize;
             let (f, _) = base_dip(&heap_loads(false, 0.3, seed), 40, 5, 400, SEED);
-            flat_calls += (f.verdict == "M") as usize;
+            hump_calls += (f.verdict == "M") as usize;
             // Noise alone lifts the side maxima: the no-dip mean is positive.
             assert!(f.dip_null > 0.0, "seed {seed}: {f:?}");
         }
         assert!(m_calls >= 18, "an M called M in {m_calls} of 20 heaps");
         assert!(
-            flat_calls <= 2,
-            "a parabola called M in {flat_calls} of 20 heaps"
+            hump_calls <= 2,
+            "a parabola called M in {hump_calls} of 20 heaps"
         );
     }
 

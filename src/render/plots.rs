@@ -1,7 +1,8 @@
 //! Plots of the profiles as SVG (plotters): S_zz and S_xx along the base against
 //! X = x/l (paper 000 Fig. 3, 6, 14), the force on fixed base particles (paper 001
 //! Fig. 3b), P(f/⟨f⟩), f(θ), and P(φ) of the principal stress directions (paper 004
-//! Fig. 5).
+//! Fig. 5). The base profiles carry bands of ± one bootstrap standard error
+//! (`analyze::spread`).
 
 use super::RenderError;
 use crate::analyze::Analysis;
