@@ -467,6 +467,30 @@ fn cmd_analyze(
         s.coordination.interior,
         s.packing_fraction_lower_half
     );
+    if let Some(b) = &s.base_load {
+        let (mg, sp) = (b.grain_weight, &b.spread);
+        out!(
+            "base load over {} base particles, in m g (bootstrap se of {} replicas): centre {:.2} ± {:.2}, side maxima {:.2} ± {:.2} (left) and {:.2} ± {:.2} (right)",
+            analyze::BASE_SPAN,
+            sp.bootstrap_replicas,
+            b.centre / mg,
+            sp.centre_se / mg,
+            b.left_max / mg,
+            sp.left_max_se / mg,
+            b.right_max / mg,
+            sp.right_max_se / mg
+        );
+        out!(
+            "dip D = mean side maximum - centre = {:.2} ± {:.2} m g; noise on a plateau gives {:.2} ± {:.2}: z = {:.2}, p = {:.3}: {}",
+            sp.dip / mg,
+            sp.dip_se / mg,
+            sp.dip_null / mg,
+            sp.dip_null_sd / mg,
+            sp.dip_z,
+            sp.dip_p,
+            sp.verdict
+        );
+    }
     out!("wrote {} files to {}", files.len(), dir.display());
     Ok(())
 }

@@ -1074,3 +1074,141 @@ fn an_m_shaped_base_load_has_its_side_maxima_above_the_centre() {
         "axis and legend"
     );
 }
+
+/// A row of fixed base particles at x = 0, 1, … each pressed down by the mobile grain
+/// on it with `loads[k]` (the one at the middle highest: the apex there).
+fn base_input(name: &str, loads: &[f64]) -> analyze::input::Input {
+    use analyze::input::{Grain, Input, Touch};
+    let grain = |id: u32, x: f64, z: f64, fixed: bool| Grain {
+        id,
+        x,
+        z,
+        theta: 0.0,
+        radius: 0.5,
+        mass: 1.0,
+        fixed,
+        area: std::f64::consts::FRAC_PI_4,
+        corners: Vec::new(),
+    };
+    let mut grains = Vec::new();
+    let mut touches = Vec::new();
+    for (k, &f) in loads.iter().enumerate() {
+        grains.push(grain(k as u32, k as f64, 0.5, true));
+        let top = if k == loads.len() / 2 { 1.6 } else { 1.5 };
+        grains.push(grain(1000 + k as u32, k as f64, top, false));
+        touches.push(Touch {
+            a: 2 * k + 1,
+            b: Some(2 * k),
+            force: [0.0, f],
+            normal_force: f,
+            point: [k as f64, 1.0],
+        });
+    }
+    Input {
+        source: PathBuf::from(name),
+        scene: name.into(),
+        units: "reduced".into(),
+        step: 0,
+        time: 0.0,
+        grains,
+        touches,
+        g: 1.0,
+        mu: None,
+        log: None,
+        length_unit: "sigma".into(),
+        force_unit: "m g".into(),
+    }
+}
+
+#[test]
+fn the_base_load_summary_tells_an_m_from_force_chain_noise() {
+    // Issue 20 item 6. 81 base loads 10 (1 − u)(1 + a u), u = x² for x from −1 to 1,
+    // times 1 + 0.1 N(0, 1): a = 3.3 is a broad M (maxima 40 % above the centre), a = 0
+    // a parabola. The summary carries standard errors and a verdict: M with z > 2 for
+    // the first, not M for the second; the same input gives the same bytes.
+    let mut rng = talus::rng::Rng::new(42);
+    let mut normal = || {
+        let u = 1.0 - rng.uniform();
+        (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * rng.uniform()).cos()
+    };
+    let noise: Vec<f64> = (0..81).map(|_| 0.1 * normal()).collect();
+    let loads = |a: f64| -> Vec<f64> {
+        (0..81)
+            .map(|k| {
+                let u = ((k as f64 - 40.0) / 40.0).powi(2);
+                10.0 * (1.0 - u) * (1.0 + a * u) * (1.0 + noise[k])
+            })
+            .collect()
+    };
+    let m = analyze::analyze(base_input("m", &loads(3.3)), &Options::default()).unwrap();
+    let b = m.summary.base_load.clone().unwrap();
+    assert_eq!(b.spread.verdict, "M", "{b:?}");
+    assert!(b.spread.dip_z > 2.0 && b.spread.dip_p < 0.025, "{b:?}");
+    assert!(b.left_max - b.centre > 2.0 * b.spread.dip_se, "{b:?}");
+    // Standard errors of the order of the noise of a 5-particle average (10 % of ~10,
+    // over √5: ~0.45), not zero and not the loads themselves.
+    for se in [
+        b.spread.centre_se,
+        b.spread.left_max_se,
+        b.spread.right_max_se,
+    ] {
+        assert!(se > 0.2 && se < 1.5, "{b:?}");
+    }
+    let hump = analyze::analyze(base_input("hump", &loads(0.0)), &Options::default()).unwrap();
+    let h = hump.summary.base_load.unwrap();
+    assert_ne!(h.spread.verdict, "M", "{h:?}");
+    assert!(h.spread.dip_z < 2.0, "{h:?}");
+    // Written: the summary's new fields, a se column of the base forces and of the
+    // windows; twice the same bytes.
+    let (one, two) = (tmp("m-verdict-1"), tmp("m-verdict-2"));
+    analyze::write(&m, &one).unwrap();
+    let again = analyze::analyze(base_input("m", &loads(3.3)), &Options::default()).unwrap();
+    analyze::write(&again, &two).unwrap();
+    for f in [
+        "summary.json",
+        "base_forces.csv",
+        "stress.csv",
+        "base_profile.csv",
+    ] {
+        let (a, b) = (
+            std::fs::read(one.join(f)).unwrap(),
+            std::fs::read(two.join(f)).unwrap(),
+        );
+        assert!(a == b, "{f} differs between two analyses of the same input");
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(one.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "centre_se",
+        "dip",
+        "dip_se",
+        "dip_null",
+        "dip_z",
+        "dip_p",
+        "verdict",
+    ] {
+        assert!(
+            summary["base_load"].get(key).is_some(),
+            "summary.json lacks {key}"
+        );
+    }
+    let csv = std::fs::read_to_string(one.join("base_forces.csv")).unwrap();
+    assert!(
+        csv.lines()
+            .next()
+            .unwrap()
+            .ends_with("se of F_B over 5 base particles/mg")
+    );
+    let se: f64 = csv
+        .lines()
+        .nth(40)
+        .unwrap()
+        .rsplit(',')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(se > 0.0 && se < 1.5, "{csv}");
+    let stress = std::fs::read_to_string(one.join("stress.csv")).unwrap();
+    assert!(stress.lines().next().unwrap().ends_with("se S_xx,se S_zz"));
+}

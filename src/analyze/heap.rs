@@ -251,12 +251,8 @@ pub fn base_forces(grains: &[Grain], touches: &[Touch]) -> Vec<BaseForce> {
 /// The base loads averaged over `span` neighbouring base particles (an odd number),
 /// fewer at the ends: the M profile without the particle-to-particle raggedness.
 pub fn smoothed_loads(base: &[BaseForce], span: usize) -> Vec<(f64, f64)> {
-    let half = span / 2;
-    (0..base.len())
-        .map(|k| {
-            let (lo, hi) = (k.saturating_sub(half), (k + half + 1).min(base.len()));
-            let mean = base[lo..hi].iter().map(|b| b.load).sum::<f64>() / (hi - lo) as f64;
-            (base[k].x, mean)
-        })
+    let loads: Vec<f64> = base.iter().map(|b| b.load).collect();
+    (base.iter().zip(super::spread::smooth(&loads, span)))
+        .map(|(b, mean)| (b.x, mean))
         .collect()
 }

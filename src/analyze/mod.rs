@@ -2,11 +2,13 @@
 //! (units in the headers) and a JSON summary. One concept per module: `input` (reading
 //! the snapshot and its run), `stress` (paper 000 eq. 8–9 and moving averages), `heap`
 //! (outline, free surface, angle of repose, base pressure), `network` (coordination,
-//! force distribution), `structure` (packing fraction, f(θ), Q(r)).
+//! force distribution), `structure` (packing fraction, f(θ), Q(r)), `spread` (bootstrap
+//! standard errors of the base load and the stress windows).
 
 pub mod heap;
 pub mod input;
 pub mod network;
+pub mod spread;
 pub mod stress;
 pub mod structure;
 
@@ -98,7 +100,8 @@ pub const BASE_SPAN: usize = 5;
 /// `BASE_SPAN` neighbouring base particles, its value under the apex and its largest
 /// value on each side (from `BASE_SPAN` particles beyond the one under the apex, so that
 /// the sides share no particle with the centre's average). An M profile has side maxima
-/// above the centre.
+/// above the centre; `spread` says whether they stand above it by more than noise
+/// (issue 20 item 6).
 #[derive(Clone, Debug, Serialize)]
 pub struct BaseLoad {
     pub particles: usize,
@@ -109,6 +112,10 @@ pub struct BaseLoad {
     pub centre: f64,
     pub left_max: f64,
     pub right_max: f64,
+    /// Standard errors, the dip D and its verdict (`spread::base_dip`), as fields of
+    /// `base_load` in summary.json.
+    #[serde(flatten)]
+    pub spread: spread::DipSpread,
 }
 
 /// The scalar results (summary.json).
@@ -160,6 +167,11 @@ pub struct Analysis {
     pub surface: Vec<heap::SurfacePoint>,
     pub wall_pressure: Vec<(f64, f64)>,
     pub base_forces: Vec<heap::BaseForce>,
+    /// The bootstrap standard error of each base particle's smoothed load.
+    pub base_load_se: Vec<f64>,
+    /// The bootstrap standard errors [σ_xx, σ_zz] of each window (of the last snapshot's
+    /// grains when the windows average several).
+    pub window_se: Vec<[f64; 2]>,
     pub force_pdf: Vec<(f64, f64)>,
     pub layers: Vec<structure::Layer>,
     pub axes: Vec<Option<f64>>,
@@ -248,41 +260,41 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
     let mobile: Vec<&input::Grain> = grains.iter().filter(|g| !g.fixed).collect();
     let grain_weight =
         mobile.iter().map(|g| g.mass).sum::<f64>() / mobile.len().max(1) as f64 * input.g;
+    let mut base_load_se = Vec::new();
     let base_load = (!base_forces.is_empty()).then(|| {
-        let smooth = heap::smoothed_loads(&base_forces, BASE_SPAN);
-        let c = (0..smooth.len())
+        let loads: Vec<f64> = base_forces.iter().map(|b| b.load).collect();
+        // The centre: the base particle nearest under the apex.
+        let c = (0..base_forces.len())
             .min_by(|&p, &q| {
-                (smooth[p].0 - o.apex_x)
+                (base_forces[p].x - o.apex_x)
                     .abs()
-                    .total_cmp(&(smooth[q].0 - o.apex_x).abs())
+                    .total_cmp(&(base_forces[q].x - o.apex_x).abs())
             })
             .unwrap_or(0);
-        let centre = smooth[c].1;
-        // The sides start beyond the particles averaged into the centre's value.
-        let side_max = |left: bool| {
-            smooth
-                .iter()
-                .enumerate()
-                .filter(|(k, _)| {
-                    if left {
-                        k + BASE_SPAN <= c
-                    } else {
-                        *k >= c + BASE_SPAN
-                    }
-                })
-                .map(|(_, p)| p.1)
-                .fold(f64::NEG_INFINITY, f64::max)
-        };
+        let dip = spread::Dip::of(&loads, c, BASE_SPAN);
+        let (dip_spread, se) =
+            spread::base_dip(&loads, c, BASE_SPAN, spread::BASE_REPLICAS, spread::SEED);
+        base_load_se = se;
         BaseLoad {
             particles: base_forces.len(),
-            total: base_forces.iter().map(|b| b.load).sum(),
+            total: loads.iter().sum(),
             mobile_weight: mobile.iter().map(|g| g.mass).sum::<f64>() * input.g,
             grain_weight,
-            centre,
-            left_max: side_max(true),
-            right_max: side_max(false),
+            centre: dip.centre,
+            left_max: dip.left_max,
+            right_max: dip.right_max,
+            spread: dip_spread,
         }
     });
+    let window_se = spread::window_se(
+        grains,
+        &moments,
+        &windows,
+        o.base,
+        opt.row * d,
+        opt.window * d,
+        BASE_SPAN,
+    );
     let layers = structure::packing(grains, &o, opt.layer * d, d);
     let lower: Vec<f64> = layers
         .iter()
@@ -350,6 +362,8 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
         surface,
         wall_pressure,
         base_forces,
+        base_load_se,
+        window_se,
         force_pdf,
         layers,
         axes,
@@ -488,13 +502,31 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, AnalyzeError> {
             v(smin / sc),
         ]
     };
+    // The bootstrap standard errors of a window's σ_xx and σ_zz, and of S_xx and S_zz;
+    // after the other columns, so that those keep their places.
+    let se_header = [
+        format!("se sigma_xx [{stress_unit}]"),
+        format!("se sigma_zz [{stress_unit}]"),
+        "se S_xx".into(),
+        "se S_zz".into(),
+    ];
+    let se_row = |k: usize| {
+        let [xx, zz] = a.window_se[k];
+        vec![v(xx), v(zz), v(xx / s.stress_scale), v(zz / s.stress_scale)]
+    };
     put(
         "stress.csv",
         table(
-            &window_header(&["row".into(), format!("z_lo [{l}]"), format!("z_hi [{l}]")]),
-            a.windows.iter().map(|w| {
+            &{
+                let mut hd =
+                    window_header(&["row".into(), format!("z_lo [{l}]"), format!("z_hi [{l}]")]);
+                hd.extend(se_header.clone());
+                hd
+            },
+            a.windows.iter().enumerate().map(|(k, w)| {
                 let mut r = vec![w.row.to_string(), v(w.z_lo), v(w.z_hi)];
                 r.extend(window_row(w));
+                r.extend(se_row(k));
                 r
             }),
         ),
@@ -506,16 +538,17 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, AnalyzeError> {
                 let mut hd = window_header(&[]);
                 hd.push(format!("wall pressure [{stress_unit}]"));
                 hd.push("S_wall".into());
+                hd.extend(se_header.clone());
                 hd
             },
-            a.windows
-                .iter()
-                .filter(|w| w.row == 0)
+            (a.windows.iter().enumerate())
+                .filter(|(_, w)| w.row == 0)
                 .zip(&a.wall_pressure)
-                .map(|(w, &(_, p))| {
+                .map(|((k, w), &(_, p))| {
                     let mut r = window_row(w);
                     r.push(v(p));
                     r.push(v(p / s.stress_scale));
+                    r.extend(se_row(k));
                     r
                 }),
         ),
@@ -533,8 +566,9 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, AnalyzeError> {
                     &format!("F_B [{f}]"),
                     "F_B/mg",
                     &format!("F_B over {BASE_SPAN} base particles/mg"),
+                    &format!("se of F_B over {BASE_SPAN} base particles/mg"),
                 ]),
-                a.base_forces.iter().zip(&smooth).map(|(b, sm)| {
+                (a.base_forces.iter().zip(&smooth).zip(&a.base_load_se)).map(|((b, sm), se)| {
                     vec![
                         a.input.grains[b.grain].id.to_string(),
                         v(b.x),
@@ -542,6 +576,7 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, AnalyzeError> {
                         v(b.load),
                         v(b.load / mg),
                         v(sm.1 / mg),
+                        v(se / mg),
                     ]
                 }),
             ),

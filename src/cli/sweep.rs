@@ -136,6 +136,24 @@ fn collect(dir: &Path) -> Result<(), Failure> {
         dir.join("collect").display(),
         files.len()
     );
+    for p in &c.points {
+        if let Some(d) = &p.dip {
+            out!(
+                "  point {}{}: base-load dip above noise {:.2} ± {:.2} m g (se over {} seeds), z = {:.2}: {} ({} of {} heaps M alone)",
+                p.point,
+                (p.values.iter())
+                    .map(|v| format!(" {v}"))
+                    .collect::<String>(),
+                d.excess.mean,
+                d.excess.se,
+                d.excess.n,
+                d.z,
+                d.verdict,
+                d.heaps_called_m,
+                d.excess.n
+            );
+        }
+    }
     for r in c.runs.iter().filter(|r| r.status != "measured") {
         out!(
             "  {}: {}{}",
@@ -615,7 +633,7 @@ pub fn reproduce(
             })
         };
         out!(
-            "{id} {} ({} of {} seeds measured): repose left {}, right {}, mean {}; height {} d; packing {}; Z interior {}; S_zz(1) apex {} max {}; base load centre {} side max {} m g, ratio {}",
+            "{id} {} ({} of {} seeds measured): repose left {}, right {}, mean {}; height {} d; packing {}; Z interior {}; S_zz(1) apex {} max {}; base load centre {} side max {} m g, ratio {}, dip above noise {} m g",
             v.name,
             point.measured,
             point.runs,
@@ -629,7 +647,8 @@ pub fn reproduce(
             show("row1_szz_max", ""),
             show("base_load_centre_mg", ""),
             show("base_load_side_max_mg", ""),
-            show("base_load_centre_over_side_max", "")
+            show("base_load_centre_over_side_max", ""),
+            show("base_load_dip_excess_mg", "")
         );
         if let Some((_, profile)) = point.profiles.iter().find(|p| p.0 == "szz_row1")
             && !profile.is_empty()

@@ -1,7 +1,8 @@
 //! Plots of the profiles as SVG (plotters): S_zz and S_xx along the base against
 //! X = x/l (paper 000 Fig. 3, 6, 14), the force on fixed base particles (paper 001
 //! Fig. 3b), P(f/⟨f⟩), f(θ), and P(φ) of the principal stress directions (paper 004
-//! Fig. 5).
+//! Fig. 5). The base profiles carry bands of ± one bootstrap standard error
+//! (`analyze::spread`).
 
 use super::RenderError;
 use crate::analyze::Analysis;
@@ -139,11 +140,18 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
         a.windows.iter().filter(|w| w.row == 0).collect();
     let xs = |x: f64| (x - o.left) / o.width;
     let mut files = Vec::new();
+    // Bands of ± one bootstrap standard error (`analyze::spread`).
+    let band = |value: &dyn Fn(usize) -> f64, se: &dyn Fn(usize) -> f64| -> Vec<(f64, f64, f64)> {
+        (a.windows.iter().enumerate())
+            .filter(|(_, w)| w.row == 0)
+            .map(|(k, w)| (xs(w.x), value(k) - se(k), value(k) + se(k)))
+            .collect()
+    };
     let p = dir.join("base_profile.svg");
-    plot(
+    plot_with_bands(
         &p,
         &format!(
-            "{}: stress along the base (moving averages)",
+            "{}: stress along the base (moving averages, ± one se)",
             a.summary.scene
         ),
         "X = x / l",
@@ -160,6 +168,16 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
                 base.iter().map(|w| (xs(w.x), w.sigma.xx / sc)).collect(),
             ),
         ],
+        &[
+            (
+                BLUE,
+                band(&|k| a.windows[k].sigma.zz / sc, &|k| a.window_se[k][1] / sc),
+            ),
+            (
+                RED,
+                band(&|k| a.windows[k].sigma.xx / sc, &|k| a.window_se[k][0] / sc),
+            ),
+        ],
     )?;
     files.push(p);
     if let Some(load) = &a.summary.base_load {
@@ -168,9 +186,15 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
         let smooth =
             crate::analyze::heap::smoothed_loads(&a.base_forces, crate::analyze::BASE_SPAN);
         let p = dir.join("base_forces.svg");
-        plot(
+        let over = (smooth.iter().zip(&a.base_load_se))
+            .map(|(&(x, f), se)| (xs(x), (f - se) / mg, (f + se) / mg))
+            .collect();
+        plot_with_bands(
             &p,
-            &format!("{}: normal force on the base particles", a.summary.scene),
+            &format!(
+                "{}: normal force on the base particles ({}: z = {:.1})",
+                a.summary.scene, load.spread.verdict, load.spread.dip_z
+            ),
             "X = x / l",
             "F_B / m g",
             &[
@@ -183,11 +207,12 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
                         .collect(),
                 ),
                 (
-                    "over 5",
+                    "over 5, ± one se",
                     BLUE,
                     smooth.iter().map(|&(x, f)| (xs(x), f / mg)).collect(),
                 ),
             ],
+            &[(BLUE, over)],
         )?;
         files.push(p);
     }

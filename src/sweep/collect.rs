@@ -150,6 +150,50 @@ pub struct PointRow {
     pub stats: Vec<(String, Stat)>,
     /// The seed-averaged profiles, by name (`PROFILES`).
     pub profiles: Vec<(String, Vec<Band>)>,
+    /// The base-load dip over the seeds, when the runs stand on fixed base particles.
+    pub dip: Option<DipOverSeeds>,
+}
+
+/// Whether a point's heaps have an M base load (issue 20 item 6): the seed mean of each
+/// heap's dip less what noise gives it (`base_load_dip_excess_mg`: unbiased by the
+/// maxima of noise) against its standard error over seeds, and how many heaps alone
+/// were called M.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct DipOverSeeds {
+    /// In m g.
+    pub excess: Stat,
+    /// excess.mean / excess.se.
+    pub z: f64,
+    pub heaps_called_m: usize,
+    /// `M` (z ≥ 2), `no significant dip`, or `one seed` (no spread over seeds: see the
+    /// run's own verdict).
+    pub verdict: &'static str,
+}
+
+pub fn dip_over_seeds(measured: &[&Measures]) -> Option<DipOverSeeds> {
+    let excess: Vec<f64> = (measured.iter())
+        .filter_map(|m| Some(m.base_load_dip_mg? - m.base_load_dip_null_mg?))
+        .collect();
+    let s = stat(&excess);
+    if s.n == 0 {
+        return None;
+    }
+    let z = s.mean / s.se;
+    let z_significant = crate::analyze::spread::Z_SIGNIFICANT;
+    Some(DipOverSeeds {
+        excess: s,
+        z,
+        heaps_called_m: (measured.iter())
+            .filter(|m| m.base_load_dip_z.is_some_and(|z| z >= z_significant))
+            .count(),
+        verdict: if s.n < 2 {
+            "one seed"
+        } else if z >= z_significant {
+            "M"
+        } else {
+            "no significant dip"
+        },
+    })
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -253,6 +297,7 @@ pub fn point_row(
         measured: measured.len(),
         stats,
         profiles,
+        dip: dip_over_seeds(measured),
     }
 }
 
@@ -455,6 +500,51 @@ mod tests {
         assert_eq!((bands[0].mean, bands[0].n), (1.0, 1));
         assert_eq!((bands[1].mean, bands[1].n, bands[1].std), (3.0, 2, 0.0));
         assert_eq!((bands[2].mean, bands[2].n), (5.0, 1));
+    }
+
+    /// A run's measures with only the base-load dip set (None: a measures.json from
+    /// before the dip).
+    fn measures(dip: Option<(f64, f64, f64)>) -> Measures {
+        let mut v = serde_json::json!({
+            "grains": 1, "time": 1.0, "repose_left_deg": 20.0, "repose_right_deg": 20.0,
+            "height_d": 1.0, "packing_fraction_lower_half": 0.8, "coordination_interior": 4.0,
+            "stress_ratio_interior_row1": 0.5, "row1_szz_centre": 1.0, "row1_szz_max": 1.0,
+            "base_load_centre_mg": 10.0, "base_load_left_max_mg": 11.0,
+            "base_load_right_max_mg": 11.0, "szz_row1": [], "base_force": [], "packing": []
+        });
+        if let Some((d, null, z)) = dip {
+            v["base_load_dip_mg"] = d.into();
+            v["base_load_dip_null_mg"] = null.into();
+            v["base_load_dip_z"] = z.into();
+        }
+        serde_json::from_value(v).unwrap()
+    }
+
+    #[test]
+    fn the_dip_over_seeds_is_the_mean_excess_over_noise_against_its_se() {
+        // Excesses 1.0, 1.2, 0.8 m g: mean 1, sd 0.2, se 0.2/√3, z = 5√3: an M, two of the
+        // three heaps called M alone.
+        let m = [
+            measures(Some((2.0, 1.0, 2.5))),
+            measures(Some((2.0, 0.8, 1.0))),
+            measures(Some((1.5, 0.7, 3.0))),
+        ];
+        let d = dip_over_seeds(&m.iter().collect::<Vec<_>>()).unwrap();
+        assert_eq!((d.excess.n, d.heaps_called_m, d.verdict), (3, 2, "M"));
+        assert!((d.excess.mean - 1.0).abs() < 1e-12 && (d.z - 5.0 * 3f64.sqrt()).abs() < 1e-9);
+        // Excesses 1, −1, 0.5 straddle zero; one seed has no spread; old measures none.
+        let m = [
+            measures(Some((2.0, 1.0, 2.5))),
+            measures(Some((0.0, 1.0, -1.0))),
+            measures(Some((1.5, 1.0, 0.5))),
+        ];
+        let d = dip_over_seeds(&m.iter().collect::<Vec<_>>()).unwrap();
+        assert_eq!(d.verdict, "no significant dip");
+        assert_eq!(dip_over_seeds(&[&m[0]]).unwrap().verdict, "one seed");
+        assert_eq!(dip_over_seeds(&[&measures(None)]), None);
+        // The scalars carry the excess per run for runs.csv and points.csv.
+        let sc = m[1].scalars();
+        assert!(sc.contains(&("base_load_dip_excess_mg", -1.0)), "{sc:?}");
     }
 
     #[test]

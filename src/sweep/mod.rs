@@ -500,6 +500,18 @@ pub struct Measures {
     pub base_load_centre_mg: Option<f64>,
     pub base_load_left_max_mg: Option<f64>,
     pub base_load_right_max_mg: Option<f64>,
+    /// The base-load dip D = mean side maximum − centre in m g, its bootstrap se, and
+    /// what noise alone gives on a plateau (`analyze::spread::DipSpread`), and the z
+    /// of D against the latter; None without a fixed base, or in a measures.json from
+    /// before them.
+    #[serde(default)]
+    pub base_load_dip_mg: Option<f64>,
+    #[serde(default)]
+    pub base_load_dip_se_mg: Option<f64>,
+    #[serde(default)]
+    pub base_load_dip_null_mg: Option<f64>,
+    #[serde(default)]
+    pub base_load_dip_z: Option<f64>,
     /// S_zz(1) against (x − x_apex)/width (paper 000 Fig. 3).
     pub szz_row1: Vec<(f64, f64)>,
     /// F_B/mg on each fixed base particle against (x − x_apex)/d (paper 001 Fig. 3b).
@@ -544,6 +556,10 @@ impl Measures {
             base_load_centre_mg: f.base_load_centre_mg,
             base_load_left_max_mg: f.base_load_left_max_mg,
             base_load_right_max_mg: f.base_load_right_max_mg,
+            base_load_dip_mg: s.base_load.as_ref().map(|b| b.spread.dip / mg),
+            base_load_dip_se_mg: s.base_load.as_ref().map(|b| b.spread.dip_se / mg),
+            base_load_dip_null_mg: s.base_load.as_ref().map(|b| b.spread.dip_null / mg),
+            base_load_dip_z: s.base_load.as_ref().map(|b| b.spread.dip_z),
             szz_row1: finite(f.row1_profile.into_iter()),
             base_force: finite(
                 (a.base_forces.iter()).map(|b| ((b.x - s.outline.apex_x) / d, b.load / mg)),
@@ -583,6 +599,15 @@ impl Measures {
                 "base_load_centre_over_side_max",
                 opt(self.base_load_centre_mg) / side_max,
             ),
+            ("base_load_dip_mg", opt(self.base_load_dip_mg)),
+            ("base_load_dip_se_mg", opt(self.base_load_dip_se_mg)),
+            // D less what noise gives: its seed mean is the dip without the maxima's
+            // upward bias, and its se over seeds says whether the M is real.
+            (
+                "base_load_dip_excess_mg",
+                opt(self.base_load_dip_mg) - opt(self.base_load_dip_null_mg),
+            ),
+            ("base_load_dip_z", opt(self.base_load_dip_z)),
         ]
     }
 }
