@@ -2,9 +2,13 @@
 //! grains in their true shapes coloured by a field, the force network with line width
 //! proportional to the normal force (paper 000 Fig. 9 and 11), the principal stresses
 //! of the moving-average windows as crosses (Fig. 12), and plots of the profiles
-//! (plotters): S_zz and S_xx along the base, P(f/⟨f⟩), f(θ).
+//! (plotters): S_zz and S_xx along the base, P(f/⟨f⟩), f(θ). Under each picture of
+//! grains a legend strip (`legend`) gives a length scale and the key to its colours or
+//! line sizes, with units.
 
+mod legend;
 pub mod plots;
+mod text;
 pub mod vtk;
 
 use crate::analyze::Analysis;
@@ -64,7 +68,9 @@ const RAMP: [[u8; 3]; 9] = [
     [253, 231, 37],
 ];
 
-fn ramp(t: f64) -> [u8; 3] {
+/// The colour of `t` ∈ [0, 1] on the grains' colour scale (the colour bar's ramp, left
+/// to right); NaN is ramp(0).
+pub fn ramp(t: f64) -> [u8; 3] {
     let t = if t.is_finite() {
         t.clamp(0.0, 1.0)
     } else {
@@ -81,8 +87,18 @@ fn ramp(t: f64) -> [u8; 3] {
     ]
 }
 
-/// The value of `field` per grain, scaled to [0, 1] (by its 2nd and 98th percentiles).
-fn field_values(a: &Analysis, field: Field) -> Vec<f64> {
+/// What the colours of a picture mean: `label` (the quantity and its unit) from `lo`
+/// at ramp(0) to `hi` at ramp(1).
+struct Scale {
+    label: String,
+    lo: f64,
+    hi: f64,
+}
+
+/// The value of `field` per grain, scaled to [0, 1] (by its 2nd and 98th percentiles,
+/// so that a few extreme grains do not wash out the rest), and the scale that maps it
+/// (None for one colour).
+fn field_values(a: &Analysis, field: Field) -> (Vec<f64>, Option<Scale>) {
     let raw: Vec<f64> = a
         .input
         .grains
@@ -98,19 +114,34 @@ fn field_values(a: &Analysis, field: Field) -> Vec<f64> {
             Field::Plain => 0.6,
         })
         .collect();
-    if matches!(field, Field::Orientation | Field::Plain) {
-        return raw;
-    }
+    let label = match field {
+        // The grain's stress is a 2D stress: force per length (CSV `sigma_* [f/l]`).
+        Field::Pressure => format!("pressure [{}/{}]", a.input.force_unit, a.input.length_unit),
+        Field::Contacts => "contacts [-]".into(),
+        Field::Orientation => {
+            let scale = Scale {
+                label: "long axis from horizontal [rad]".into(),
+                lo: 0.0,
+                hi: std::f64::consts::PI,
+            };
+            return (raw, Some(scale));
+        }
+        Field::Plain => return (raw, None),
+    };
     let mut sorted: Vec<f64> = raw.iter().copied().filter(|v| v.is_finite()).collect();
     sorted.sort_by(f64::total_cmp);
     if sorted.is_empty() {
-        return raw;
+        return (raw, None);
     }
     let q = |p: f64| sorted[((sorted.len() - 1) as f64 * p).round() as usize];
-    let (lo, hi) = (q(0.02), q(0.98));
-    raw.iter()
-        .map(|v| if hi > lo { (v - lo) / (hi - lo) } else { 0.5 })
-        .collect()
+    let (mut lo, mut hi) = (q(0.02), q(0.98));
+    if hi <= lo {
+        // One value for all: it sits mid-scale, on a bar around it.
+        let d = if lo == 0.0 { 1.0 } else { 0.5 * lo.abs() };
+        (lo, hi) = (lo - d, hi + d);
+    }
+    let values = raw.iter().map(|v| (v - lo) / (hi - lo)).collect();
+    (values, Some(Scale { label, lo, hi }))
 }
 
 /// World (length units, z up) to picture (pixels, y down).
@@ -146,7 +177,8 @@ impl View {
     }
 }
 
-/// One picture, drawn once into a pixmap and once into SVG text.
+/// One picture, drawn once into a pixmap and once into SVG text: the view of the heap,
+/// and under it the legend strip.
 struct Canvas {
     view: View,
     pixmap: Pixmap,
@@ -155,9 +187,10 @@ struct Canvas {
 
 impl Canvas {
     fn new(view: View) -> Result<Canvas, RenderError> {
-        let mut pixmap = Pixmap::new(view.width, view.height).ok_or(RenderError::TooLarge {
+        let height = view.height.saturating_add(legend::height(view.width));
+        let mut pixmap = Pixmap::new(view.width, height).ok_or(RenderError::TooLarge {
             width: view.width,
-            height: view.height,
+            height,
         })?;
         pixmap.fill(Color::WHITE);
         let mut svg = String::new();
@@ -166,7 +199,7 @@ impl Canvas {
             r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}">
 <rect width="100%" height="100%" fill="white"/>"#,
             w = view.width,
-            h = view.height
+            h = height
         );
         Ok(Canvas { view, pixmap, svg })
     }
@@ -280,6 +313,8 @@ impl Canvas {
 
 const GREY: [u8; 3] = [200, 200, 200];
 const INK: [u8; 3] = [30, 30, 30];
+const COMPRESSION: [u8; 3] = [30, 60, 200];
+const TENSION: [u8; 3] = [200, 40, 40];
 
 /// Writes every picture of `a` into `dir`; `width` is the pictures' width in pixels.
 pub fn render(
@@ -293,7 +328,7 @@ pub fn render(
     let view = View::of(a, width);
     let line = (0.04 * a.summary.mean_diameter * view.scale).clamp(0.3, 2.0) as f32;
     // Grains coloured by the field.
-    let values = field_values(a, field);
+    let (values, scale) = field_values(a, field);
     let mut c = Canvas::new(view)?;
     for (k, g) in a.input.grains.iter().enumerate() {
         let fill = if g.fixed {
@@ -304,6 +339,10 @@ pub fn render(
             GREY
         };
         c.shape(g, fill, Some(INK), 0.5 * line);
+    }
+    legend::length_scale(&mut c, &a.input.length_unit);
+    if let Some(s) = scale {
+        legend::colour_bar(&mut c, &s.label, s.lo, s.hi);
     }
     c.save(dir, "grains", &mut files)?;
     // Force network: grains faint, each contact a line from centre to centre (to the
@@ -336,7 +375,10 @@ pub fn render(
                 INK,
             );
         }
+        let label = format!("normal force [{}]", a.input.force_unit);
+        legend::width_key(&mut c, &label, fmax, wmax);
     }
+    legend::length_scale(&mut c, &a.input.length_unit);
     c.save(dir, "forces", &mut files)?;
     // Principal stresses of the moving-average windows: crosses at the window centres
     // (every `row` height along each row), arms along φ and φ + π/2 proportional to σ_max
@@ -370,15 +412,21 @@ pub fn render(
             for (s, ang) in [(s1, phi), (s2, phi + std::f64::consts::FRAC_PI_2)] {
                 let half = 0.45 * row_h * s.abs() / smax;
                 let (dx, dz) = (half * ang.cos(), half * ang.sin());
-                let color = if s >= 0.0 {
-                    [30, 60, 200]
-                } else {
-                    [200, 40, 40]
-                };
+                let color = if s >= 0.0 { COMPRESSION } else { TENSION };
                 c.line((w.x - dx, z - dz), (w.x + dx, z + dz), 1.5 * line, color);
             }
         }
+        if smax > 0.0 {
+            let label = format!(
+                "principal stress [{}/{}]",
+                a.input.force_unit, a.input.length_unit
+            );
+            let arms = [(COMPRESSION, "compression"), (TENSION, "tension")];
+            let thick = (1.5 * line).round().max(1.0) as u32;
+            legend::arm_key(&mut c, &label, smax, 0.9 * row_h * view.scale, thick, arms);
+        }
     }
+    legend::length_scale(&mut c, &a.input.length_unit);
     c.save(dir, "stress_crosses", &mut files)?;
     files.extend(plots::write_plots(a, dir)?);
     Ok(files)

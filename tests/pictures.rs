@@ -1,0 +1,382 @@
+//! `talus render`'s pictures say what they show: each picture of grains has, under the
+//! heap, a length scale and the key to its colours (the colour bar of the field, with
+//! its name, unit and range) or line sizes, in the scene's units. Checked on a
+//! hand-built column whose stresses are known exactly, in the SVG text and in the
+//! decoded PNG's pixels.
+
+use std::f64::consts::PI;
+use std::path::PathBuf;
+use talus::analyze::input::{Grain, Input, Touch};
+use talus::analyze::{self, Analysis, Options};
+use talus::render::{self, Field, ramp};
+use tiny_skia::Pixmap;
+
+const N: usize = 6;
+const WIDTH: u32 = 400;
+const INK: [u8; 3] = [30, 30, 30];
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("talus-pictures-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A column of N disks (diameter 1, mass 1, g = 1) standing on a floor, each contact
+/// carrying exactly the weight above it: grain k (from the bottom) has (N − k) m g under
+/// it and (N − k − 1) m g on top. Its stress Σ f ⊗ l / (π r²) is σ_zz = (2N − 2k − 1) m g
+/// / (π r), σ_xx = 0, so its pressure (σ_zz + σ_xx)/2 is (2N − 2k − 1)/π with r = 1/2:
+/// 1/π at the top, (2N − 1)/π at the bottom.
+fn column(units: &str) -> Analysis {
+    let grains = (0..N)
+        .map(|k| Grain {
+            id: k as u32,
+            x: 0.0,
+            z: 0.5 + k as f64,
+            theta: 0.0,
+            radius: 0.5,
+            mass: 1.0,
+            fixed: false,
+            area: PI / 4.0,
+            corners: Vec::new(),
+        })
+        .collect();
+    let touches = (0..N)
+        .map(|k| Touch {
+            a: k,
+            b: k.checked_sub(1),
+            force: [0.0, (N - k) as f64],
+            normal_force: (N - k) as f64,
+            point: [0.0, k as f64],
+        })
+        .collect();
+    let (length, force) = if units == "si" {
+        ("m", "N")
+    } else {
+        ("sigma", "m g")
+    };
+    let input = Input {
+        source: PathBuf::from("column"),
+        scene: "column".into(),
+        units: units.into(),
+        step: 0,
+        time: 0.0,
+        grains,
+        touches,
+        g: 1.0,
+        mu: None,
+        log: None,
+        length_unit: length.into(),
+        force_unit: force.into(),
+    };
+    analyze::analyze(input, &Options::default()).unwrap()
+}
+
+/// Renders `a` coloured by `field`; returns the folder.
+fn draw(a: &Analysis, field: Field, name: &str) -> PathBuf {
+    let dir = tmp(name);
+    render::render(a, &dir, field, WIDTH).unwrap();
+    dir
+}
+
+/// Rows of the picture that show the heap: the outline with its margin of 4 % of the
+/// larger side, at the scale that fits its width into the picture (as `View::of`).
+fn heap_rows(a: &Analysis) -> u32 {
+    let o = &a.summary.outline;
+    let pad = 0.04 * o.width.max(o.height);
+    let scale = WIDTH as f64 / (o.width + 2.0 * pad);
+    ((o.height + 2.0 * pad) * scale).ceil() as u32
+}
+
+/// The lines of the SVG group `<g id="id">`, empty if there is none.
+fn group<'a>(svg: &'a str, id: &str) -> Vec<&'a str> {
+    let open = format!("<g id=\"{id}\">");
+    svg.lines()
+        .skip_while(|l| *l != open)
+        .skip(1)
+        .take_while(|l| *l != "</g>")
+        .collect()
+}
+
+fn attr<'a>(line: &'a str, name: &str) -> &'a str {
+    let key = format!(" {name}=\"");
+    let start = line
+        .find(&key)
+        .unwrap_or_else(|| panic!("{name} in {line}"))
+        + key.len();
+    &line[start..start + line[start..].find('"').unwrap()]
+}
+
+fn num(line: &str, name: &str) -> f64 {
+    attr(line, name).parse().unwrap()
+}
+
+/// A `<text>` of a legend: its role, anchor point, glyph size, anchor and words.
+struct Text {
+    class: String,
+    x: f64,
+    y: f64,
+    size: f64,
+    end: bool,
+    words: String,
+}
+
+fn texts(lines: &[&str]) -> Vec<Text> {
+    (lines.iter().filter(|l| l.starts_with("<text")))
+        .map(|l| Text {
+            class: attr(l, "class").into(),
+            x: num(l, "x"),
+            y: num(l, "y"),
+            size: num(l, "font-size"),
+            end: attr(l, "text-anchor") == "end",
+            words: l[l.find('>').unwrap() + 1..l.rfind("</text>").unwrap()].into(),
+        })
+        .collect()
+}
+
+fn text<'a>(texts: &'a [Text], class: &str) -> &'a Text {
+    (texts.iter().find(|t| t.class == class)).unwrap_or_else(|| panic!("a {class} text"))
+}
+
+fn rgb(png: &Pixmap, x: u32, y: u32) -> [u8; 3] {
+    let p = png.pixel(x, y).unwrap();
+    [p.red(), p.green(), p.blue()]
+}
+
+/// Asserts that the PNG spells `t` as the SVG places it: every pixel of its 8 × 8
+/// glyphs, scaled, is ink where the glyph has a dot and white elsewhere.
+fn assert_spelled(png: &Pixmap, t: &Text, colour: [u8; 3]) {
+    let k = (t.size / 8.0) as u32;
+    let n = t.words.chars().count() as u32;
+    let left = if t.end {
+        t.x as u32 - 8 * k * n
+    } else {
+        t.x as u32
+    };
+    for (i, c) in t.words.chars().enumerate() {
+        let glyph = font8x8::legacy::BASIC_LEGACY[c as usize];
+        for (row, bits) in glyph.iter().enumerate() {
+            for col in 0..8u32 {
+                let want = if bits >> col & 1 == 1 {
+                    colour
+                } else {
+                    [255; 3]
+                };
+                let x = left + 8 * k * i as u32 + col * k + k / 2;
+                let y = t.y as u32 + row as u32 * k + k / 2;
+                assert_eq!(
+                    rgb(png, x, y),
+                    want,
+                    "'{c}' of \"{}\" at glyph row {row}, column {col}",
+                    t.words
+                );
+            }
+        }
+    }
+}
+
+/// The rows of the PNG that run through the whole colour ramp, as (y, left, right):
+/// ramp(0) at the left end, ramp(1) at the right, and every pixel between the ramp's
+/// colour at its place.
+fn ramp_rows(png: &Pixmap) -> Vec<(u32, u32, u32)> {
+    let (c0, c1) = (ramp(0.0), ramp(1.0));
+    (0..png.height())
+        .filter_map(|y| {
+            let x0 = (0..png.width()).find(|&x| rgb(png, x, y) == c0)?;
+            let x1 = (0..png.width()).rev().find(|&x| rgb(png, x, y) == c1)?;
+            let n = x1.checked_sub(x0).filter(|&n| n >= 20)?;
+            (x0..=x1)
+                .all(|x| rgb(png, x, y) == ramp((x - x0) as f64 / n as f64))
+                .then_some((y, x0, x1))
+        })
+        .collect()
+}
+
+#[test]
+fn the_grains_picture_has_a_colour_bar_of_the_pressure_with_unit_and_range() {
+    let a = column("reduced");
+    let dir = draw(&a, Field::Pressure, "pressure");
+    let svg = std::fs::read_to_string(dir.join("grains.svg")).unwrap();
+    let bar = group(&svg, "colour-bar");
+    let words = texts(&bar);
+    // The field, its unit (a 2D stress: force per length), and the range of the colours,
+    // here the whole range: the 2nd and 98th percentiles of six values are the ends.
+    assert_eq!(text(&words, "label").words, "pressure [m g/sigma]");
+    let (lo, hi): (f64, f64) = (
+        text(&words, "min").words.parse().unwrap(),
+        text(&words, "max").words.parse().unwrap(),
+    );
+    assert!((lo * PI - 1.0).abs() < 2e-3, "min {lo}, 1/π");
+    let top = (2 * N - 1) as f64;
+    assert!((hi * PI / top - 1.0).abs() < 2e-3, "max {hi}, {top}/π");
+    // The gradient runs through the ramp's colours, ramp(0) first.
+    let stops: Vec<&str> = bar[0].split("stop-color=\"").skip(1).collect();
+    assert_eq!(stops.len(), 9);
+    for (k, s) in stops.iter().enumerate() {
+        let c = ramp(k as f64 / 8.0);
+        assert!(
+            s.starts_with(&format!("rgb({},{},{})", c[0], c[1], c[2])),
+            "{s}"
+        );
+    }
+
+    // In the PNG: the bar's rows run through the ramp left to right, under the heap, at
+    // the place the SVG gives it; the top grain (lowest pressure) is ramp(0).
+    let png = Pixmap::load_png(dir.join("grains.png")).unwrap();
+    let rows = ramp_rows(&png);
+    assert!(
+        !rows.is_empty(),
+        "no row of the PNG runs through the colour ramp"
+    );
+    let rect = bar.iter().find(|l| l.starts_with("<rect")).unwrap();
+    let (y0, x0, x1) = rows[0];
+    assert_eq!(x0 as f64, num(rect, "x"));
+    assert_eq!((x1 - x0 + 1) as f64, num(rect, "width"));
+    assert_eq!(y0 as f64, num(rect, "y"));
+    assert_eq!(rows.len() as f64, num(rect, "height"), "the bar's rows");
+    assert!(rows.iter().all(|r| r.1 == x0 && r.2 == x1));
+    assert!(x1 - x0 >= WIDTH / 4, "a bar {} pixels long", x1 - x0);
+    assert!(y0 >= heap_rows(&a), "the bar lies under the heap");
+    let top_grain = a.input.grains.last().unwrap();
+    let o = &a.summary.outline;
+    let pad = 0.04 * o.width.max(o.height);
+    let scale = WIDTH as f64 / (o.width + 2.0 * pad);
+    let centre = |g: &Grain| {
+        (
+            ((g.x - o.left + pad) * scale) as u32,
+            ((o.top + pad - g.z) * scale) as u32,
+        )
+    };
+    let (x, y) = centre(top_grain);
+    assert_eq!(rgb(&png, x, y), ramp(0.0), "the top grain");
+    let (x, y) = centre(&a.input.grains[0]);
+    assert_eq!(rgb(&png, x, y), ramp(1.0), "the bottom grain");
+    // The label and the numbers are written in the PNG as in the SVG.
+    for t in &words {
+        assert_spelled(&png, t, INK);
+    }
+}
+
+#[test]
+fn units_follow_the_scene_and_every_field_but_plain_has_a_bar() {
+    let a = column("si");
+    for (field, label, ends) in [
+        (Field::Pressure, "pressure [N/m]", None),
+        // One contact under the top grain, two under the others.
+        (Field::Contacts, "contacts [-]", Some(("1", "2"))),
+        // Angles of a long axis, in [0, π).
+        (
+            Field::Orientation,
+            "long axis from horizontal [rad]",
+            Some(("0", "3.14")),
+        ),
+    ] {
+        let name = format!("si-{}", label.split(' ').next().unwrap());
+        let dir = draw(&a, field, &name);
+        let svg = std::fs::read_to_string(dir.join("grains.svg")).unwrap();
+        let words = texts(&group(&svg, "colour-bar"));
+        assert_eq!(text(&words, "label").words, label);
+        if let Some((lo, hi)) = ends {
+            assert_eq!(text(&words, "min").words, lo, "{label}");
+            assert_eq!(text(&words, "max").words, hi, "{label}");
+        }
+        let scale = texts(&group(&svg, "length-scale"));
+        assert!(text(&scale, "label").words.ends_with(" m"), "SI length");
+        let png = Pixmap::load_png(dir.join("grains.png")).unwrap();
+        assert!(!ramp_rows(&png).is_empty(), "{label}: a bar in the PNG");
+    }
+    // One colour says nothing: no bar, but still a length scale.
+    let dir = draw(&a, Field::Plain, "si-plain");
+    let svg = std::fs::read_to_string(dir.join("grains.svg")).unwrap();
+    assert!(group(&svg, "colour-bar").is_empty() && !svg.contains("colour-bar"));
+    assert!(!group(&svg, "length-scale").is_empty());
+    let png = Pixmap::load_png(dir.join("grains.png")).unwrap();
+    assert!(ramp_rows(&png).is_empty(), "no colour bar without colours");
+}
+
+#[test]
+fn every_picture_has_a_length_scale_of_a_round_length_drawn_to_scale() {
+    let a = column("reduced");
+    let dir = draw(&a, Field::Pressure, "scale");
+    for stem in ["grains", "forces", "stress_crosses"] {
+        let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap();
+        let part = group(&svg, "length-scale");
+        let words = texts(&part);
+        let label = &text(&words, "label").words;
+        let value: f64 = (label.strip_suffix(" sigma"))
+            .unwrap_or_else(|| panic!("{stem}: \"{label}\" in sigma"))
+            .parse()
+            .unwrap();
+        let mantissa = value / 10f64.powf(value.log10().floor());
+        assert!(
+            [1.0, 2.0, 5.0].iter().any(|m| (mantissa - m).abs() < 1e-9),
+            "{stem}: {value} is round"
+        );
+        // Pixels per length from a grain's drawn radius (the grains are r = 1/2).
+        let circle = svg.lines().find(|l| l.starts_with("<circle")).unwrap();
+        let per_length = num(circle, "r") / 0.5;
+        let bar = part[0];
+        let length = num(bar, "width");
+        assert!(
+            (length - value * per_length).abs() <= 1.0,
+            "{stem}: {length} pixels for {value} at {per_length} per sigma"
+        );
+        assert!(
+            (0.08..=0.2).contains(&(length / WIDTH as f64)),
+            "{stem}: about a fifth of the width"
+        );
+        // In the PNG: the bar is ink along its length, under the heap.
+        let png = Pixmap::load_png(dir.join(format!("{stem}.png"))).unwrap();
+        let y = (num(bar, "y") + 0.5 * num(bar, "height")) as u32;
+        assert!(y >= heap_rows(&a), "{stem}: the scale lies under the heap");
+        let x0 = num(bar, "x") as u32;
+        for x in x0..x0 + length as u32 {
+            assert_eq!(rgb(&png, x, y), INK, "{stem}: scale bar at x = {x}");
+        }
+        assert_spelled(&png, text(&words, "label"), INK);
+    }
+}
+
+#[test]
+fn the_force_network_and_stress_crosses_have_keys_in_units() {
+    let a = column("reduced");
+    let dir = draw(&a, Field::Pressure, "keys");
+    // Forces: a wedge whose width at its end is the width a line has for the force
+    // written there, the floor's N m g having the widest line.
+    let svg = std::fs::read_to_string(dir.join("forces.svg")).unwrap();
+    let key = group(&svg, "width-key");
+    let words = texts(&key);
+    assert_eq!(text(&words, "label").words, "normal force [m g]");
+    let f: f64 = text(&words, "max").words.parse().unwrap();
+    assert!(f > 0.0 && f <= N as f64, "key force {f}");
+    let wmax = (svg.lines().filter(|l| l.starts_with("<line")))
+        .map(|l| num(l, "stroke-width"))
+        .fold(0.0, f64::max);
+    let points: Vec<f64> = attr(key[0], "points")
+        .split([' ', ','])
+        .map(|v| v.parse().unwrap())
+        .collect();
+    let thick = points[5] - points[3];
+    assert!(
+        (thick / wmax - f / N as f64).abs() < 0.01,
+        "wedge {thick} px for {f}, line {wmax} px for {N}"
+    );
+    let png = Pixmap::load_png(dir.join("forces.png")).unwrap();
+    for t in &words {
+        assert_spelled(&png, t, INK);
+    }
+    // Stress crosses: an arm per colour with the stress it stands for and its meaning.
+    let svg = std::fs::read_to_string(dir.join("stress_crosses.svg")).unwrap();
+    let key = group(&svg, "arm-key");
+    let words = texts(&key);
+    assert_eq!(text(&words, "label").words, "principal stress [m g/sigma]");
+    let values: Vec<&str> = (words.iter().filter(|t| t.class == "value"))
+        .map(|t| t.words.as_str())
+        .collect();
+    assert_eq!(values.len(), 2);
+    assert!(values[0].ends_with(" compression") && values[1].ends_with(" tension"));
+    let png = Pixmap::load_png(dir.join("stress_crosses.png")).unwrap();
+    for (t, colour) in words.iter().zip([INK, [30, 60, 200], [200, 40, 40]]) {
+        assert_spelled(&png, t, colour);
+    }
+}
