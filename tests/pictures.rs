@@ -1,8 +1,8 @@
 //! `talus render`'s pictures say what they show: each picture of grains has, under the
 //! heap, a length scale and the key to its colours (the colour bar of the field, with
-//! its name, unit and range) or line sizes, in the scene's units. Checked on a
-//! hand-built column whose stresses are known exactly, in the SVG text and in the
-//! decoded PNG's pixels.
+//! its name, unit and range) or line sizes, in the scene's units; each plot's axes
+//! carry units. Checked on a hand-built column whose stresses are known exactly, in the
+//! SVG text and in the decoded PNG's pixels.
 
 use std::f64::consts::PI;
 use std::path::PathBuf;
@@ -379,4 +379,32 @@ fn the_force_network_and_stress_crosses_have_keys_in_units() {
     for (t, colour) in words.iter().zip([INK, [30, 60, 200], [200, 40, 40]]) {
         assert_spelled(&png, t, colour);
     }
+}
+
+#[test]
+fn every_plot_labels_both_axes_with_units() {
+    let a = column("reduced");
+    let dir = draw(&a, Field::Pressure, "plots");
+    let plots: Vec<PathBuf> = (std::fs::read_dir(&dir).unwrap())
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "svg"))
+        .filter(|p| {
+            !["grains", "forces", "stress_crosses"]
+                .iter()
+                .any(|s| p.ends_with(format!("{s}.svg")))
+        })
+        .collect();
+    assert!(plots.len() >= 3, "{plots:?}");
+    for p in plots {
+        let svg = std::fs::read_to_string(&p).unwrap();
+        // plotters writes each label as the text of one element; an axis label is the
+        // only text that ends in a bracketed unit.
+        let units = (svg.split("</text>"))
+            .filter_map(|s| s.rsplit('>').next().map(str::trim))
+            .filter(|t| t.ends_with(']') && t.contains(" ["))
+            .count();
+        assert_eq!(units, 2, "{}: two axes with units", p.display());
+    }
+    let svg = std::fs::read_to_string(dir.join("base_profile.svg")).unwrap();
+    assert!(svg.contains("X = x / l [-]") && svg.contains("S = 2 sigma / (rho g h) [-]"));
 }

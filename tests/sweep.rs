@@ -172,6 +172,11 @@ fn a_sweep_runs_every_combination_and_collects_its_statistics() {
     assert!(!bands.is_empty());
     let svg = std::fs::read_to_string(dir.join("collect/packing.svg")).unwrap();
     assert!(svg.contains("<polygon"), "no band drawn");
+    assert!(
+        svg.contains("depth below the top [mean diameters]")
+            && svg.contains("packing fraction [-]"),
+        "axes with units"
+    );
 
     // A run made the way a Slurm array task makes it, on another thread count, is the
     // same to the bit.

@@ -671,8 +671,8 @@ pub fn reproduce(
         talus::render::plots::write_bands(
             &path,
             &format!("{id}: vertical stress in row 1, seed means ± one standard deviation"),
-            "X - X_apex",
-            "S_zz(1) = 2 sigma_zz / (rho g h)",
+            talus::render::plots::Axis::new("X - X_apex", "heap widths"),
+            talus::render::plots::Axis::new("S_zz(1) = 2 sigma_zz / (rho g h)", "-"),
             &bands,
         )?;
     }

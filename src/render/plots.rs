@@ -30,23 +30,34 @@ const PALETTE: [RGBColor; 8] = [
 /// A shaded band (x, low, high) under a series of the same colour.
 type Band = (RGBColor, Vec<(f64, f64, f64)>);
 
+/// An axis of a plot: the quantity and its unit, drawn as "name [unit]"; the unit of a
+/// ratio or a count is "-". A type rather than a string so that no axis goes without.
+#[derive(Clone, Copy, Debug)]
+pub struct Axis<'a> {
+    pub name: &'a str,
+    pub unit: &'a str,
+}
+
+impl<'a> Axis<'a> {
+    pub const fn new(name: &'a str, unit: &'a str) -> Axis<'a> {
+        Axis { name, unit }
+    }
+    fn label(&self) -> String {
+        format!("{} [{}]", self.name, self.unit)
+    }
+}
+
 /// One line plot; `series` share the axes.
-fn plot(
-    path: &Path,
-    title: &str,
-    x_label: &str,
-    y_label: &str,
-    series: &[Series],
-) -> Result<(), RenderError> {
-    plot_with_bands(path, title, x_label, y_label, series, &[])
+fn plot(path: &Path, title: &str, x: Axis, y: Axis, series: &[Series]) -> Result<(), RenderError> {
+    plot_with_bands(path, title, x, y, series, &[])
 }
 
 /// One line plot with shaded bands (drawn first, under the lines).
 fn plot_with_bands(
     path: &Path,
     title: &str,
-    x_label: &str,
-    y_label: &str,
+    x: Axis,
+    y: Axis,
     series: &[Series],
     bands: &[Band],
 ) -> Result<(), RenderError> {
@@ -90,8 +101,8 @@ fn plot_with_bands(
             .map_err(|x| e(&x))?;
         chart
             .configure_mesh()
-            .x_desc(x_label)
-            .y_desc(y_label)
+            .x_desc(x.label())
+            .y_desc(y.label())
             .draw()
             .map_err(|x| e(&x))?;
         for (color, band) in bands {
@@ -154,8 +165,8 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
             "{}: stress along the base (moving averages, ± one se)",
             a.summary.scene
         ),
-        "X = x / l",
-        "S = 2 sigma / (rho g h)",
+        Axis::new("X = x / l", "-"),
+        Axis::new("S = 2 sigma / (rho g h)", "-"),
         &[
             (
                 "S_zz",
@@ -195,8 +206,8 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
                 "{}: normal force on the base particles ({}: z = {:.1})",
                 a.summary.scene, load.spread.verdict, load.spread.dip_z
             ),
-            "X = x / l",
-            "F_B / m g",
+            Axis::new("X = x / l", "-"),
+            Axis::new("F_B / m g", "-"),
             &[
                 (
                     "each",
@@ -220,8 +231,8 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
     plot(
         &p,
         "normal forces between grains",
-        "f / <f>",
-        "P(f / <f>)",
+        Axis::new("f / <f>", "-"),
+        Axis::new("P(f / <f>)", "-"),
         &[("P", BLACK, a.force_pdf.clone())],
     )?;
     files.push(p);
@@ -229,8 +240,8 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
     plot(
         &p,
         "principal stress directions of the grains",
-        "phi [rad]",
-        "P(phi) [1/rad]",
+        Axis::new("phi", "rad"),
+        Axis::new("P(phi)", "1/rad"),
         &[("P", BLACK, a.principal_directions.clone())],
     )?;
     files.push(p);
@@ -239,8 +250,8 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
         plot(
             &p,
             "orientation of the long axes",
-            "theta [rad]",
-            "f(theta) [1/rad]",
+            Axis::new("theta", "rad"),
+            Axis::new("f(theta)", "1/rad"),
             &[("f", BLACK, a.orientation.clone())],
         )?;
         files.push(p);
@@ -263,8 +274,8 @@ pub fn write_profiles(
     plot(
         path,
         title,
-        "X - X_apex",
-        "S_zz(1) = 2 sigma_zz / (rho g h)",
+        Axis::new("X - X_apex", "heap widths"),
+        Axis::new("S_zz(1) = 2 sigma_zz / (rho g h)", "-"),
         &series,
     )
 }
@@ -275,8 +286,8 @@ pub fn write_profiles(
 pub fn write_bands(
     path: &Path,
     title: &str,
-    x_label: &str,
-    y_label: &str,
+    x: Axis,
+    y: Axis,
     means: &[Means],
 ) -> Result<(), RenderError> {
     let colour = |k: usize| PALETTE[k % PALETTE.len()];
@@ -292,5 +303,5 @@ pub fn write_bands(
             (colour(k), band)
         })
         .collect();
-    plot_with_bands(path, title, x_label, y_label, &series, &bands)
+    plot_with_bands(path, title, x, y, &series, &bands)
 }

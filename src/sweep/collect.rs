@@ -96,8 +96,8 @@ fn interpolate(p: &[(f64, f64)], x: f64) -> Option<f64> {
 struct Profile {
     name: &'static str,
     title: &'static str,
-    x_label: &'static str,
-    y_label: &'static str,
+    x: plots::Axis<'static>,
+    y: plots::Axis<'static>,
     of: fn(&Measures) -> &[(f64, f64)],
 }
 
@@ -105,22 +105,22 @@ const PROFILES: [Profile; 3] = [
     Profile {
         name: "szz_row1",
         title: "S_zz in row 1, seed average ± one standard deviation",
-        x_label: "X - X_apex (heap widths)",
-        y_label: "S_zz(1) = 2 sigma_zz / (rho g h)",
+        x: plots::Axis::new("X - X_apex", "heap widths"),
+        y: plots::Axis::new("S_zz(1) = 2 sigma_zz / (rho g h)", "-"),
         of: |m| &m.szz_row1,
     },
     Profile {
         name: "base_force",
         title: "Force on the fixed base particles, seed average ± one standard deviation",
-        x_label: "x - x_apex (mean diameters)",
-        y_label: "F_B / m g",
+        x: plots::Axis::new("x - x_apex", "mean diameters"),
+        y: plots::Axis::new("F_B / m g", "-"),
         of: |m| &m.base_force,
     },
     Profile {
         name: "packing",
         title: "Packing fraction against depth, seed average ± one standard deviation",
-        x_label: "depth below the top (mean diameters)",
-        y_label: "packing fraction",
+        x: plots::Axis::new("depth below the top", "mean diameters"),
+        y: plots::Axis::new("packing fraction", "-"),
         of: |m| &m.packing,
     },
 ];
@@ -462,7 +462,7 @@ pub fn write(dir: &Path, c: &Collection) -> Result<Vec<PathBuf>, SweepError> {
             continue;
         }
         let path = out.join(format!("{}.svg", profile.name));
-        let (title, x, y) = (profile.title, profile.x_label, profile.y_label);
+        let (title, x, y) = (profile.title, profile.x, profile.y);
         plots::write_bands(&path, title, x, y, &means).map_err(|e| SweepError::Damaged {
             path: path.display().to_string(),
             reason: e.to_string(),
