@@ -198,8 +198,10 @@ pub(super) fn colour_bar(c: &mut Canvas, label: &str, lo: f64, hi: f64) {
         s.x0, s.bar_y, s.u
     );
     // In the PNG one column per pixel, each the ramp's colour at its place.
-    let mut paint = Paint::default();
-    paint.anti_alias = false;
+    let mut paint = Paint {
+        anti_alias: false,
+        ..Default::default()
+    };
     for i in 0..n {
         let col = ramp(i as f64 / (n - 1) as f64);
         paint.set_color_rgba8(col[0], col[1], col[2], 255);
