@@ -263,7 +263,7 @@ pub(super) fn width_key(c: &mut Canvas, label: &str, fmax: f64, wmax: f32) {
 }
 
 /// The stress crosses' key: an arm `thick` wide for a round stress (at most `smax`,
-/// whose arm is `full` pixels long, and at most half the key's span), once in each
+/// whose arm is `full` pixels long, and at most a third of the key's span), once in each
 /// colour of the crosses with what the colour means; `label` names the quantity.
 pub(super) fn arm_key(
     c: &mut Canvas,
@@ -274,7 +274,8 @@ pub(super) fn arm_key(
     arms: [([u8; 3], &str); 2],
 ) {
     let s = Strip::of(c);
-    let fits = (0.5 * (s.x1 - s.x0) as f64 / full).min(1.0);
+    // A third of the span leaves room for the words after the arm.
+    let fits = ((s.x1 - s.x0) as f64 / 3.0 / full).min(1.0);
     let Some((stress, value)) = round_down(smax * fits) else {
         return;
     };
