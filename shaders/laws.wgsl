@@ -157,22 +157,34 @@ fn continuous(c: ContactInput) -> ContactOutput {
 
 // Overlap-area law of polygons, paper 000 eq. 6-7 (src/law/overlap_area.rs): delta is
 // A/l, r the depth A/L; eta_n and eta_t arrive in gamma_n and gamma_t.
+// The coefficients come from the pair's slot: (k_n, eta_n, k_t, eta_t) and mu, k per
+// unit of the effective mass in the material form (src/law/overlap_area.rs `evaluate`).
 fn overlap_area(c: ContactInput) -> ContactOutput {
-    let gamma_n = params.gamma_n * sqrt(c.m12 * params.k_n);
-    let gamma_t = params.gamma_t * sqrt(c.m12 * params.k_t);
-    let f_el = params.k_n * c.delta;
+    let pl = params.pair_law[2u * c.pair];
+    let mu = params.pair_law[2u * c.pair + 1u].x;
+    var m = c.m12;
+    var k_n = pl.x;
+    var k_t = pl.z;
+    if (params.per_mass != 0u) {
+        m = c.m_eff;
+        k_n = pl.x * m;
+        k_t = pl.z * m;
+    }
+    let gamma_n = pl.y * sqrt(m * k_n);
+    let gamma_t = pl.w * sqrt(m * k_t);
+    let f_el = k_n * c.delta;
     let f_n = max(f_el + gamma_n * c.delta_dot, 0.0);
     let xi = c.history + c.v_t * c.dt;
-    let trial = -params.k_t * xi - gamma_t * c.v_t;
-    let cap = params.mu * f_n;
+    let trial = -k_t * xi - gamma_t * c.v_t;
+    let cap = mu * f_n;
     var f_t = trial;
     var xs = xi;
     if (abs(trial) > cap) {
         f_t = select(-cap, cap, trial >= 0.0);
         xs = 0.0;
-        if (params.k_t > 0.0) { xs = -f_t / params.k_t; }
+        if (k_t > 0.0) { xs = -f_t / k_t; }
     }
-    let energy = 0.5 * f_el * c.r + 0.5 * params.k_t * xs * xs;
+    let energy = 0.5 * f_el * c.r + 0.5 * k_t * xs * xs;
     return ContactOutput(f_n, f_t, xs, energy);
 }
 

@@ -776,12 +776,17 @@ fn cmd_check(
         run::total_steps(&sim),
         sim.dt()
     );
-    if let talus::law::ContactLaw::SpringDashpot(l) = &sim.law {
-        let names: Vec<String> = sim.scene.materials.keys().cloned().collect();
-        let masses = scene::typical_masses(&sim.scene);
-        for line in talus::law::restitution::describe(l, &names, &masses) {
-            out!("{line}");
+    let names: Vec<String> = sim.scene.materials.keys().cloned().collect();
+    let lines = match &sim.law {
+        talus::law::ContactLaw::SpringDashpot(l) => {
+            let masses = scene::typical_masses(&sim.scene);
+            talus::law::restitution::describe(l, &names, &masses)
         }
+        talus::law::ContactLaw::OverlapArea(l) => l.describe(&names),
+        _ => Vec::new(),
+    };
+    for line in lines {
+        out!("{line}");
     }
     if let Some(backend) = estimate {
         estimate_run_time(sim, backend)?;

@@ -741,6 +741,7 @@ fn area_kinematics(
         (0.0, 0.0)
     };
     let v_n = -(v12[0] * c.n[0] + v12[1] * c.n[1]);
+    let (m_eff, pair_slot) = material_pair(s, pair, m12);
     let input = ContactInput {
         delta,
         r: depth,
@@ -751,7 +752,8 @@ fn area_kinematics(
         mass: 2.0 * m12,
         history,
         dt,
-        ..Default::default()
+        m_eff,
+        pair: pair_slot,
     };
     let g = Geometry {
         n: c.n,

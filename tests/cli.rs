@@ -204,7 +204,7 @@ fn the_material_form_refuses_what_does_not_belong() {
             format!("contact={contact}"),
         ]
     };
-    let cases: [(&str, &[&str]); 9] = [
+    let cases: [(&str, &[&str]); 11] = [
         (
             r#"{"law": "spring_dashpot", "restitution": 0.75}"#,
             &["contact.contact_time", "required"],
@@ -240,6 +240,14 @@ fn the_material_form_refuses_what_does_not_belong() {
         (
             r#"{"law": "spring_dashpot", "k_n": 2000, "pairs": [{"materials": ["grain", "walls"]}]}"#,
             &["contact.pairs", "material form"],
+        ),
+        (
+            r#"{"law": "overlap_area", "restitution": 0.5, "contact_time": 0.05, "eta_n": 0.3}"#,
+            &["contact.eta_n", "stiffness form"],
+        ),
+        (
+            r#"{"law": "overlap_area", "restitution": 0.1, "contact_time": 0.05}"#,
+            &["contact.restitution", "0.1353"],
         ),
     ];
     for (contact, mention) in cases {

@@ -76,6 +76,12 @@ fn wgsl_laws_match_their_rust_twins() {
             1e-5,
         ),
         (
+            "overlap area, material form",
+            json!({ "law": "overlap_area", "restitution": 0.5, "contact_time": 0.05, "mu": 0.5,
+                    "pairs": [{ "materials": ["m", "walls"], "restitution": 0.3 }] }),
+            1e-5,
+        ),
+        (
             "Hertz-like, clamped",
             json!({ "law": "spring_dashpot", "k_n": 2000.0, "nu": 1.5, "psi": 0.5, "delta0": 0.01,
                     "gamma_n": 5.0, "k_t": 500.0, "gamma_t": 1.0, "mu": 0.4, "clamp": true }),

@@ -130,6 +130,45 @@ fn material_form_round_trips_restitution_and_contact_time() {
     }
 }
 
+/// Issue 20: the overlap-area law's material form is calibrated on a face-to-face
+/// collision (src/law/overlap_area.rs): two hexagons meeting face to face, moving or
+/// one fixed, give the e and t_c asked for to 5e-3 (measured: t_c 3.0e-3 short, e 1.4e-3
+/// low, the same on both paths: the force point moves in by half the penetration, so L/l
+/// stiffens by up to p/2a ≈ 0.4 % during the contact).
+#[test]
+fn material_form_of_polygons_is_exact_face_to_face() {
+    let (e, t_c) = (0.5, 0.02);
+    let a = 0.5 * (std::f64::consts::PI / 6.0).cos(); // inradius of a hexagon of diameter 1
+    for path in PATHS {
+        for fixed in [false, true] {
+            let law =
+                json!({ "law": "overlap_area", "restitution": e, "contact_time": t_c, "mu": 0.5 });
+            // A face along ±x: the corners at 30° + 60° k.
+            let theta = std::f64::consts::PI / 6.0;
+            let mut v = scene_value(
+                law,
+                json!([
+                    { "kind": "list", "material": "m", "polygon": { "corners": 6 }, "particles": [
+                        { "position": [-a - 0.001, 0.0], "diameter": 1.0, "theta": theta, "velocity": [1.0, 0.0] },
+                        { "position": [a + 0.001, 0.0], "diameter": 1.0, "theta": theta, "fixed": fixed }]}
+                ]),
+            );
+            v["dt"] = json!(t_c / 4000.0);
+            let Some((t, got)) = head_on_scene(path, &v, 1.0, 2.0 * a) else {
+                continue;
+            };
+            assert!(
+                (t / t_c - 1.0).abs() < 5e-3,
+                "{path:?}, fixed {fixed}: t_c {t} vs {t_c}"
+            );
+            assert!(
+                (got / e - 1.0).abs() < 5e-3,
+                "{path:?}, fixed {fixed}: e {got} vs {e}"
+            );
+        }
+    }
+}
+
 /// Hertz, F = k' δ^(3/2) with k' = k_n δ0^(−1/2) (paper 000 eq. 2 with ν = 3/2), no damping:
 /// δ_max = (5 m12 v0² / (4 k'))^(2/5) and t_c = 2 (δ_max/v0) ∫0^1 (1 − u^(5/2))^(−1/2) du,
 /// the integral being √π Γ(7/5)/Γ(9/10).

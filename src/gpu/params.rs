@@ -28,6 +28,18 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             p.gamma_n = l.eta_n as f32;
             p.gamma_t = l.eta_t as f32;
             p.clamp = 1;
+            fill_pairs(
+                &ContactLaw::OverlapArea(l.clone()),
+                l.pairs.as_ref(),
+                p,
+                || crate::law::restitution::PerMass {
+                    k_n: l.k_n,
+                    gamma_n: l.eta_n,
+                    k_t: l.k_t,
+                    gamma_t: l.eta_t,
+                    mu: l.mu,
+                },
+            );
         }
         ContactLaw::HertzCohesive(l) => {
             // γ^N, γ^T are rates: the kernels multiply them by the reduced mass.
@@ -74,8 +86,29 @@ pub fn gpu_pair_side(law: &ContactLaw) -> Option<usize> {
 
 /// The spring-dashpot law's coefficients into `Params.pair_law`.
 fn pair_law(l: &crate::law::spring_dashpot::SpringDashpot, p: &mut Params) {
-    let law = ContactLaw::SpringDashpot(l.clone());
-    let side = gpu_pair_side(&law).expect("checked when the run was set up (GpuSimulation)");
+    fill_pairs(
+        &ContactLaw::SpringDashpot(l.clone()),
+        l.pairs.as_ref(),
+        p,
+        || crate::law::restitution::PerMass {
+            k_n: l.k_n,
+            gamma_n: l.gamma_n,
+            k_t: l.k_t,
+            gamma_t: l.gamma_t,
+            mu: l.mu,
+        },
+    );
+}
+
+/// A law's pair table into `Params.pair_law` (`absolute`: its one entry in the stiffness
+/// form).
+fn fill_pairs(
+    law: &ContactLaw,
+    table: Option<&crate::law::restitution::PairTable>,
+    p: &mut Params,
+    absolute: impl Fn() -> crate::law::restitution::PerMass,
+) {
+    let side = gpu_pair_side(law).expect("checked when the run was set up (GpuSimulation)");
     p.pair_side = side as u32;
     let entry = |c: &crate::law::restitution::PerMass| {
         [
@@ -88,16 +121,10 @@ fn pair_law(l: &crate::law::spring_dashpot::SpringDashpot, p: &mut Params) {
             [c.mu as f32, 0.0, 0.0, 0.0],
         ]
     };
-    match &l.pairs {
+    match table {
         None => {
             p.per_mass = 0;
-            let [a, b] = entry(&crate::law::restitution::PerMass {
-                k_n: l.k_n,
-                gamma_n: l.gamma_n,
-                k_t: l.k_t,
-                gamma_t: l.gamma_t,
-                mu: l.mu,
-            });
+            let [a, b] = entry(&absolute());
             (p.pair_law[0], p.pair_law[1]) = (a, b);
         }
         Some(t) => {

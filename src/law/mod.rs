@@ -111,15 +111,22 @@ pub enum ContactLaw {
 impl ContactLaw {
     /// Turns the scene's contact block into coefficients, checking each parameter.
     /// `g` is |gravity|, the default force scale of the continuous laws.
-    /// `materials`: the scene's material names in index order.
-    pub fn from_spec(spec: &ContactSpec, g: f64, materials: &[String]) -> Result<Self, SceneError> {
+    /// `materials`: the scene's material names in index order; `corners`: each
+    /// material's polygons' corner count (0: disks), for the overlap-area law's material
+    /// form.
+    pub fn from_spec(
+        spec: &ContactSpec,
+        g: f64,
+        materials: &[String],
+        corners: &[u32],
+    ) -> Result<Self, SceneError> {
         match spec {
             ContactSpec::SpringDashpot(s) => Ok(Self::SpringDashpot(
                 spring_dashpot::SpringDashpot::from_spec(s, materials)?,
             )),
-            ContactSpec::OverlapArea(s) => {
-                Ok(Self::OverlapArea(overlap_area::OverlapArea::from_spec(s)?))
-            }
+            ContactSpec::OverlapArea(s) => Ok(Self::OverlapArea(
+                overlap_area::OverlapArea::from_spec(s, materials, corners)?,
+            )),
             ContactSpec::Continuous(s) => {
                 Ok(Self::Continuous(continuous::Continuous::from_spec(s, g)?))
             }
@@ -136,10 +143,20 @@ impl ContactLaw {
     pub fn of_scene(scene: &crate::scene::Scene) -> Result<Self, SceneError> {
         let g = scene.gravity.g;
         let materials: Vec<String> = scene.materials.keys().cloned().collect();
+        // Each material's corner count: its first polygon block's (0 for disks).
+        let corners: Vec<u32> = (materials.iter())
+            .map(|m| {
+                (scene.particles.iter())
+                    .filter(|c| crate::scene::material_of(c) == m)
+                    .find_map(|c| crate::scene::polygon_of(c).map(|p| p.corners))
+                    .unwrap_or(0)
+            })
+            .collect();
         Self::from_spec(
             &scene.contact,
             (g[0] * g[0] + g[1] * g[1]).sqrt(),
             &materials,
+            &corners,
         )
     }
 
@@ -147,6 +164,7 @@ impl ContactLaw {
     pub fn pair_table(&self) -> Option<&restitution::PairTable> {
         match self {
             Self::SpringDashpot(l) => l.pairs.as_ref(),
+            Self::OverlapArea(l) => l.pairs.as_ref(),
             _ => None,
         }
     }

@@ -21,6 +21,7 @@
 //!   the surfaces overlap, t_c = (φ + sin φ)/ω: what the head-on test measures, and π/ω
 //!   again as η → 0. Under the clamp e > e^(−2) ≈ 0.135 (η → ∞).
 
+use crate::scene::SceneError;
 use std::f64::consts::PI;
 
 /// φ(η) = ω t*, the phase at which the clamped law's force vanishes.
@@ -70,7 +71,7 @@ pub fn eta_for(e: f64, clamp: bool) -> Option<f64> {
 pub fn collision(kappa: f64, c: f64, clamp: bool) -> Option<(f64, f64)> {
     let beta = 0.5 * c;
     let w2 = kappa - beta * beta;
-    if !(w2 > 0.0) {
+    if w2.is_nan() || w2 <= 0.0 {
         return None;
     }
     let omega = w2.sqrt();
@@ -101,12 +102,166 @@ pub fn per_mass(e: f64, t_c: f64, clamp: bool) -> Option<(f64, f64)> {
 /// One pair of materials' coefficients per unit of the contact's reduced mass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PerMass {
-    /// k_n/m (1/time²), γ_n/m (1/time), k_t/m, γ_t/m.
+    /// k_n/m (1/time²), γ_n/m (1/time), k_t/m, γ_t/m; for the overlap-area law γ_n and
+    /// γ_t hold its dimensionless η^n and η^t (src/law/overlap_area.rs).
     pub k_n: f64,
     pub gamma_n: f64,
     pub k_t: f64,
     pub gamma_t: f64,
     pub mu: f64,
+}
+
+/// The material form of a contact block: e, t_c and μ for every pair, and the pairs with
+/// values of their own.
+pub struct MaterialForm<'a> {
+    pub restitution: f64,
+    pub contact_time: f64,
+    pub mu: f64,
+    pub pairs: &'a [crate::scene::MaterialPair],
+}
+
+/// The pair table of a material form: `resolve(at, e, t_c, μ, a, b)` gives the
+/// coefficients of materials a and b (b = materials: the walls) from the values that
+/// apply to them, `at` naming the key they come from (for its errors).
+pub fn pair_table(
+    form: &MaterialForm,
+    materials: &[String],
+    resolve: impl Fn(&str, f64, f64, f64, usize, usize) -> Result<PerMass, SceneError>,
+) -> Result<PairTable, SceneError> {
+    use crate::scene::WALLS;
+    if !form.pairs.is_empty() && materials.iter().any(|m| m == WALLS) {
+        return Err(SceneError::invalid(
+            format!("materials.{WALLS}"),
+            format!("\"{WALLS}\" names the wall segments in contact.pairs: rename the material"),
+        ));
+    }
+    let side = materials.len() + 1;
+    // Which entry of `pairs` each unordered pair takes its values from.
+    let mut own = std::collections::BTreeMap::new();
+    for (k, p) in form.pairs.iter().enumerate() {
+        let at = format!("contact.pairs[{k}]");
+        let index = |name: &str| -> Result<usize, SceneError> {
+            if name == WALLS {
+                return Ok(side - 1);
+            }
+            materials.iter().position(|m| m == name).ok_or_else(|| {
+                SceneError::invalid(
+                    format!("{at}.materials"),
+                    format!(
+                        "unknown material \"{name}\" (known: {}, and \"{WALLS}\")",
+                        materials.join(", ")
+                    ),
+                )
+            })
+        };
+        let (a, b) = (index(&p.materials[0])?, index(&p.materials[1])?);
+        if a == side - 1 && b == side - 1 {
+            return Err(SceneError::invalid(
+                format!("{at}.materials"),
+                "walls do not touch walls",
+            ));
+        }
+        if own.insert((a.min(b), a.max(b)), k).is_some() {
+            return Err(SceneError::invalid(
+                format!("{at}.materials"),
+                "this pair is listed twice",
+            ));
+        }
+    }
+    let mut coeffs = vec![PerMass::default(); side * side];
+    for a in 0..side {
+        for b in a..side {
+            let (at, e, t_c, mu) = match own.get(&(a, b)) {
+                Some(&k) => {
+                    let p = &form.pairs[k];
+                    (
+                        format!("contact.pairs[{k}]"),
+                        p.restitution.unwrap_or(form.restitution),
+                        p.contact_time.unwrap_or(form.contact_time),
+                        p.mu.unwrap_or(form.mu),
+                    )
+                }
+                None => (
+                    "contact".to_string(),
+                    form.restitution,
+                    form.contact_time,
+                    form.mu,
+                ),
+            };
+            if a == side - 1 {
+                continue;
+            }
+            let c = resolve(&at, e, t_c, mu, a, b)?;
+            coeffs[a * side + b] = c;
+            coeffs[b * side + a] = c;
+        }
+    }
+    Ok(PairTable { side, coeffs })
+}
+
+/// (κ, c) of [`per_mass`] or the key's error: e out of reach, t_c not positive.
+pub fn resolve_linear(at: &str, e: f64, t_c: f64, clamp: bool) -> Result<(f64, f64), SceneError> {
+    if !(t_c.is_finite() && t_c > 0.0) {
+        return Err(SceneError::invalid(
+            format!("{at}.contact_time"),
+            format!("must be positive, got {t_c}"),
+        ));
+    }
+    per_mass(e, t_c, clamp).ok_or_else(|| {
+        let range = if clamp {
+            format!(
+                "in ({:.4}, 1] under the clamp f_n ≥ 0 (set clamp: false for less)",
+                CLAMPED_MIN_RESTITUTION
+            )
+        } else {
+            "in (0, 1]".to_string()
+        };
+        SceneError::invalid(
+            format!("{at}.restitution"),
+            format!("must be {range}, got {e}"),
+        )
+    })
+}
+
+/// The table as the scene records it (`contact.resolved`): each unordered pair once,
+/// walls last; `collide` gives the (e, t_c) a pair's coefficients give.
+pub fn resolved(
+    table: &PairTable,
+    materials: &[String],
+    collide: impl Fn(usize, usize, &PerMass) -> Option<(f64, f64)>,
+    eta: bool,
+) -> Vec<crate::scene::ResolvedPair> {
+    let name = |k: usize| {
+        materials
+            .get(k)
+            .cloned()
+            .unwrap_or_else(|| crate::scene::WALLS.to_string())
+    };
+    let mut out = Vec::new();
+    for a in 0..table.side - 1 {
+        for b in a..table.side {
+            let c = table.coeffs[a * table.side + b];
+            let (e, t_c) = collide(a, b, &c).unwrap_or((f64::NAN, f64::NAN));
+            let (rates, etas) = if eta {
+                (None, Some((c.gamma_n, c.gamma_t)))
+            } else {
+                (Some((c.gamma_n, c.gamma_t)), None)
+            };
+            out.push(crate::scene::ResolvedPair {
+                materials: [name(a), name(b)],
+                restitution: e,
+                contact_time: t_c,
+                mu: c.mu,
+                k_n_per_mass: c.k_n,
+                k_t_per_mass: c.k_t,
+                gamma_n_per_mass: rates.map(|r| r.0),
+                gamma_t_per_mass: rates.map(|r| r.1),
+                eta_n: etas.map(|r| r.0),
+                eta_t: etas.map(|r| r.1),
+            });
+        }
+    }
+    out
 }
 
 /// The coefficients of every pair of materials: `side` = materials + 1, the last row and

@@ -3,7 +3,7 @@
 use super::restitution::{PairTable, PerMass};
 use super::tangential::{coulomb_spring, spring_energy};
 use super::{ContactInput, ContactOutput, clamp_non_negative};
-use crate::scene::{ResolvedPair, SceneError, SpringDashpotSpec, WALLS};
+use crate::scene::{ResolvedPair, SceneError, SpringDashpotSpec};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpringDashpot {
@@ -137,23 +137,15 @@ impl SpringDashpot {
         }
         let kt_ratio = non_negative("contact.kt_ratio", s.kt_ratio.unwrap_or(DEFAULT_KT_RATIO))?;
         let gt_ratio = non_negative("contact.gamma_t_ratio", s.gamma_t_ratio.unwrap_or(0.0))?;
-        let mu = non_negative("contact.mu", s.mu)?;
-        let resolve = |at: &str, e: f64, t_c: f64, mu: f64| -> Result<PerMass, SceneError> {
-            positive(&format!("{at}.contact_time"), t_c)?;
-            let Some((k_n, gamma_n)) = super::restitution::per_mass(e, t_c, s.clamp) else {
-                let range = if s.clamp {
-                    format!(
-                        "in ({:.4}, 1] under the clamp f_n ≥ 0 (set clamp: false for less)",
-                        super::restitution::CLAMPED_MIN_RESTITUTION
-                    )
-                } else {
-                    "in (0, 1]".to_string()
-                };
-                return Err(SceneError::invalid(
-                    format!("{at}.restitution"),
-                    format!("must be {range}, got {e}"),
-                ));
-            };
+        let form = super::restitution::MaterialForm {
+            restitution: e,
+            contact_time: t_c,
+            mu: s.mu,
+            pairs: &s.pairs,
+        };
+        let table = super::restitution::pair_table(&form, materials, |at, e, t_c, mu, _, _| {
+            let mu = non_negative(&format!("{at}.mu"), mu)?;
+            let (k_n, gamma_n) = super::restitution::resolve_linear(at, e, t_c, s.clamp)?;
             Ok(PerMass {
                 k_n,
                 gamma_n,
@@ -161,58 +153,8 @@ impl SpringDashpot {
                 gamma_t: gt_ratio * gamma_n,
                 mu,
             })
-        };
-        if !s.pairs.is_empty() && materials.iter().any(|m| m == WALLS) {
-            return Err(SceneError::invalid(
-                format!("materials.{WALLS}"),
-                format!(
-                    "\"{WALLS}\" names the wall segments in contact.pairs: rename the material"
-                ),
-            ));
-        }
-        let base = resolve("contact", e, t_c, mu)?;
-        let side = materials.len() + 1;
-        let mut coeffs = vec![base; side * side];
-        let mut seen = std::collections::BTreeSet::new();
-        for (k, p) in s.pairs.iter().enumerate() {
-            let at = format!("contact.pairs[{k}]");
-            let index = |name: &str| -> Result<usize, SceneError> {
-                if name == WALLS {
-                    return Ok(side - 1);
-                }
-                materials.iter().position(|m| m == name).ok_or_else(|| {
-                    SceneError::invalid(
-                        format!("{at}.materials"),
-                        format!(
-                            "unknown material \"{name}\" (known: {}, and \"{WALLS}\")",
-                            materials.join(", ")
-                        ),
-                    )
-                })
-            };
-            let (a, b) = (index(&p.materials[0])?, index(&p.materials[1])?);
-            if a == side - 1 && b == side - 1 {
-                return Err(SceneError::invalid(
-                    format!("{at}.materials"),
-                    "walls do not touch walls",
-                ));
-            }
-            if !seen.insert((a.min(b), a.max(b))) {
-                return Err(SceneError::invalid(
-                    format!("{at}.materials"),
-                    "this pair is listed twice",
-                ));
-            }
-            let mu = non_negative(&format!("{at}.mu"), p.mu.unwrap_or(mu))?;
-            let c = resolve(
-                &at,
-                p.restitution.unwrap_or(e),
-                p.contact_time.unwrap_or(t_c),
-                mu,
-            )?;
-            coeffs[a * side + b] = c;
-            coeffs[b * side + a] = c;
-        }
+        })?;
+        let base = table.coeffs[0];
         Ok(Self {
             k_n: base.k_n,
             nu: 1.0,
@@ -221,46 +163,23 @@ impl SpringDashpot {
             gamma_n: base.gamma_n,
             k_t: base.k_t,
             gamma_t: base.gamma_t,
-            mu,
+            mu: s.mu,
             clamp: s.clamp,
-            pairs: Some(PairTable { side, coeffs }),
+            pairs: Some(table),
         })
     }
 
-    /// The material form's table as the scene records it (`contact.resolved`): each
-    /// unordered pair once, walls last.
+    /// The material form's table as the scene records it (`contact.resolved`).
     pub fn resolved(&self, materials: &[String]) -> Vec<ResolvedPair> {
         let Some(t) = &self.pairs else {
             return Vec::new();
         };
-        let name = |k: usize| {
-            materials
-                .get(k)
-                .cloned()
-                .unwrap_or_else(|| WALLS.to_string())
-        };
-        let mut out = Vec::new();
-        for a in 0..t.side {
-            for b in a..t.side {
-                if a == t.side - 1 {
-                    continue;
-                }
-                let c = t.coeffs[a * t.side + b];
-                let (e, t_c) = super::restitution::collision(c.k_n, c.gamma_n, self.clamp)
-                    .unwrap_or((f64::NAN, f64::NAN));
-                out.push(ResolvedPair {
-                    materials: [name(a), name(b)],
-                    restitution: e,
-                    contact_time: t_c,
-                    mu: c.mu,
-                    k_n_per_mass: c.k_n,
-                    gamma_n_per_mass: c.gamma_n,
-                    k_t_per_mass: c.k_t,
-                    gamma_t_per_mass: c.gamma_t,
-                });
-            }
-        }
-        out
+        super::restitution::resolved(
+            t,
+            materials,
+            |_, _, c| super::restitution::collision(c.k_n, c.gamma_n, self.clamp),
+            false,
+        )
     }
 
     /// The coefficients of one contact: (k_n, γ_n, k_t, γ_t, μ).

@@ -13,8 +13,8 @@ mod validate;
 pub use overrides::apply_override;
 pub use schema::*;
 pub use validate::{
-    max_diameter, polygon_of, reach_bound_of, shortest_contact_time, smallest_particle_area,
-    typical_masses, validate,
+    material_of, max_diameter, polygon_of, reach_bound_of, shortest_contact_time,
+    smallest_particle_area, typical_masses, validate,
 };
 
 /// Non-fatal remarks about a valid scene (e.g. dt above t_c/10).
@@ -73,11 +73,15 @@ pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
 /// input: a `resolved` block read back is replaced by the values computed anew.
 fn resolve_materials(scene: &mut Scene) -> Result<(), SceneError> {
     let law = crate::law::ContactLaw::of_scene(scene)?;
-    if let (ContactSpec::SpringDashpot(spec), crate::law::ContactLaw::SpringDashpot(l)) =
-        (&mut scene.contact, &law)
-    {
-        let names: Vec<String> = scene.materials.keys().cloned().collect();
-        spec.resolved = l.resolved(&names);
+    let names: Vec<String> = scene.materials.keys().cloned().collect();
+    match (&mut scene.contact, &law) {
+        (ContactSpec::SpringDashpot(spec), crate::law::ContactLaw::SpringDashpot(l)) => {
+            spec.resolved = l.resolved(&names);
+        }
+        (ContactSpec::OverlapArea(spec), crate::law::ContactLaw::OverlapArea(l)) => {
+            spec.resolved = l.resolved(&names);
+        }
+        _ => {}
     }
     Ok(())
 }

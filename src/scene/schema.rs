@@ -267,9 +267,17 @@ pub struct ResolvedPair {
     pub contact_time: f64,
     pub mu: f64,
     pub k_n_per_mass: f64,
-    pub gamma_n_per_mass: f64,
     pub k_t_per_mass: f64,
-    pub gamma_t_per_mass: f64,
+    /// The spring-dashpot's dampings per unit mass.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gamma_n_per_mass: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gamma_t_per_mass: Option<f64>,
+    /// The overlap-area law's dimensionless dampings, γ = η sqrt(m_eff k).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eta_n: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub eta_t: Option<f64>,
 }
 
 /// The name that stands for the wall segments in `contact.pairs`.
@@ -279,8 +287,22 @@ pub const WALLS: &str = "walls";
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OverlapAreaSpec {
-    /// k^n [force/length]: f_el = k^n A/l.
-    pub k_n: f64,
+    /// k^n [force/length]: f_el = k^n A/l. Either this and `eta_n` (the stiffness form)
+    /// or `restitution` and `contact_time` (the material form, calibrated on a
+    /// face-to-face collision: src/law/overlap_area.rs).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub k_n: Option<f64>,
+    /// Material form: the restitution and contact time of a face-to-face collision.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contact_time: Option<f64>,
+    /// Material form: pairs of materials with values of their own (`"walls"`: the walls).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pairs: Vec<MaterialPair>,
+    /// Material form: what talus resolved (a record, computed anew on reading).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub resolved: Vec<ResolvedPair>,
     /// Dimensionless normal damping η^n = γ^n/sqrt(m12 k^n).
     #[serde(default)]
     pub eta_n: f64,

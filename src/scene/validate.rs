@@ -240,7 +240,7 @@ pub fn typical_masses(scene: &Scene) -> Vec<Option<f64>> {
         .collect()
 }
 
-fn material_of(c: &Creation) -> &str {
+pub fn material_of(c: &Creation) -> &str {
     match c {
         Creation::LatticePile(p) => &p.material,
         Creation::Row(r) => &r.material,
@@ -280,10 +280,16 @@ fn gpu_resolution_warning(scene: &Scene, law: &ContactLaw) -> Option<String> {
     let g = scene.gravity.g[0].hypot(scene.gravity.g[1]);
     let m = lightest_mass(scene)?;
     let weight = m * g;
+    // The material form's stiffness of that particle on a fixed partner: m (k^n/m), the
+    // stiffest pair's.
+    let k_n = |k_abs: f64| match law.pair_table() {
+        Some(t) => m * t.coeffs.iter().map(|c| c.k_n).fold(0.0, f64::max),
+        None => k_abs,
+    };
     let (overlap, resolution) = match law {
-        ContactLaw::OverlapArea(l) => (weight / l.k_n, GPU_RESOLUTION_POLYGONS),
+        ContactLaw::OverlapArea(l) => (weight / k_n(l.k_n), GPU_RESOLUTION_POLYGONS),
         ContactLaw::SpringDashpot(l) => (
-            l.delta0 * (weight / (l.k_n * l.delta0)).powf(1.0 / l.nu),
+            l.delta0 * (weight / (k_n(l.k_n) * l.delta0)).powf(1.0 / l.nu),
             GPU_RESOLUTION_DISKS,
         ),
         ContactLaw::Continuous(_) | ContactLaw::HertzCohesive(_) => return None,
@@ -697,8 +703,15 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
             // acts through L/l ≈ FACE_STIFFNESS and also turns the grains. Measured on the
             // R8 pile with Gear (μ = 0, η^n = 1): 0.8 and 0.4 pump the kinetic energy up to
             // the elastic energy, 0.1 settles; leapfrog settles at 0.4.
-            let gamma =
-                l.eta_n * (0.5 * m * l.k_n).sqrt() * crate::law::overlap_area::FACE_STIFFNESS;
+            // In the material form k^n = m_eff (k^n/m) per pair: the largest γ^n/m over the
+            // pairs, at m12 = m/2 as above.
+            let gamma_over_m = match &l.pairs {
+                None => l.eta_n * (0.5 * m * l.k_n).sqrt() / m,
+                Some(t) => (t.coeffs.iter())
+                    .map(|c| c.gamma_n * 0.5 * c.k_n.sqrt())
+                    .fold(0.0, f64::max),
+            };
+            let gamma = gamma_over_m * m * crate::law::overlap_area::FACE_STIFFNESS;
             let ratio = 6.0 * gamma * scene.dt / m;
             if ratio > DAMPING_STABILITY {
                 warnings.push(format!(
