@@ -204,7 +204,7 @@ fn the_material_form_refuses_what_does_not_belong() {
             format!("contact={contact}"),
         ]
     };
-    let cases: [(&str, &[&str]); 11] = [
+    let cases: [(&str, &[&str]); 13] = [
         (
             r#"{"law": "spring_dashpot", "restitution": 0.75}"#,
             &["contact.contact_time", "required"],
@@ -227,7 +227,15 @@ fn the_material_form_refuses_what_does_not_belong() {
         ),
         (
             r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.08, "nu": 1.5}"#,
-            &["contact.restitution", "linear law"],
+            &["contact.delta0", "required"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.08, "nu": 1.5, "delta0": 0.01}"#,
+            &["contact.impact_speed", "required", "that relative speed"],
+        ),
+        (
+            r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.08, "impact_speed": 1}"#,
+            &["contact.impact_speed", "every speed"],
         ),
         (
             r#"{"law": "spring_dashpot", "restitution": 0.7, "contact_time": 0.08, "pairs": [{"materials": ["grain", "sand"]}]}"#,

@@ -99,6 +99,99 @@ pub fn per_mass(e: f64, t_c: f64, clamp: bool) -> Option<(f64, f64)> {
     Some((omega * omega + beta * beta, 2.0 * beta))
 }
 
+/// The power law's head-on collision in its own units (the nonlinear spring-dashpot,
+/// paper 000 eq. 2–3): x'' = −x^ν − D x^ψ x' from x = 0, x' = 1 (the force clamped at 0
+/// when `clamp`), with δ = X x, t = (X/v) τ (below). Returns (e, τ_c): the rebound
+/// speed and the time x > 0; None when the pair does not come apart within τ = 10³.
+/// Fourth-order Runge–Kutta at dτ = 10⁻⁴, the crossing of x = 0 interpolated.
+fn power_collision(nu: f64, psi: f64, d: f64, clamp: bool) -> Option<(f64, f64)> {
+    let accel = |x: f64, u: f64| {
+        let x = x.max(0.0);
+        let f = x.powf(nu) + d * x.powf(psi) * u;
+        -(if clamp { f.max(0.0) } else { f })
+    };
+    let h = 1e-4;
+    let (mut x, mut u, mut tau) = (0.0f64, 1.0f64, 0.0f64);
+    while tau < 1e3 {
+        let (k1x, k1u) = (u, accel(x, u));
+        let (k2x, k2u) = (
+            u + 0.5 * h * k1u,
+            accel(x + 0.5 * h * k1x, u + 0.5 * h * k1u),
+        );
+        let (k3x, k3u) = (
+            u + 0.5 * h * k2u,
+            accel(x + 0.5 * h * k2x, u + 0.5 * h * k2u),
+        );
+        let (k4x, k4u) = (u + h * k3u, accel(x + h * k3x, u + h * k3u));
+        let nx = x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+        let nu_ = u + h / 6.0 * (k1u + 2.0 * k2u + 2.0 * k3u + k4u);
+        if tau > 0.0 && nx <= 0.0 {
+            let f = x / (x - nx);
+            return Some((-(u + f * (nu_ - u)), tau + f * h));
+        }
+        (x, u, tau) = (nx, nu_, tau + h);
+    }
+    None
+}
+
+/// The nonlinear law's coefficients per unit of reduced mass, (κ, c) with k_n = m κ and
+/// γ_n = m c in f = k_n δ0 (δ/δ0)^ν + γ_n (δ/δ0)^ψ δ̇, that give restitution e and
+/// overlap time t_c in a head-on collision at the relative speed v. Per unit mass the
+/// collision is δ̈ = −κ' δ^ν − c' δ^ψ δ̇ (κ' = κ δ0^(1−ν), c' = c δ0^(−ψ)); with X =
+/// (v²/κ')^(1/(ν+1)) and T = X/v it is [`power_collision`] with D = c' X^(ψ+1)/v. So D
+/// follows from e alone (bisection: e falls as D grows), then T = t_c/τ_c. Unlike the
+/// linear law's, e and t_c then hold at that speed only (Hertz: t_c ∝ v^(−1/5)).
+pub fn per_mass_power(
+    e: f64,
+    t_c: f64,
+    v: f64,
+    (nu, psi, delta0): (f64, f64, f64),
+    clamp: bool,
+) -> Option<(f64, f64)> {
+    if !(e > 0.0 && e <= 1.0 && t_c > 0.0 && v > 0.0) {
+        return None;
+    }
+    let e_of = |d: f64| power_collision(nu, psi, d, clamp).map_or(0.0, |r| r.0);
+    let mut hi = 1.0;
+    while e_of(hi) > e {
+        hi *= 2.0;
+        if hi > 1e4 {
+            return None;
+        }
+    }
+    let mut lo = 0.0;
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if e_of(mid) > e {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let d = 0.5 * (lo + hi);
+    let (_, tau) = power_collision(nu, psi, d, clamp)?;
+    let x = v * t_c / tau;
+    let kappa = v * v / x.powf(nu + 1.0) * delta0.powf(nu - 1.0);
+    let c = d * v / x.powf(psi + 1.0) * delta0.powf(psi);
+    Some((kappa, c))
+}
+
+/// The restitution and overlap time the nonlinear law's (κ, c) give at speed v (the
+/// inverse of [`per_mass_power`]).
+pub fn collision_power(
+    kappa: f64,
+    c: f64,
+    v: f64,
+    (nu, psi, delta0): (f64, f64, f64),
+    clamp: bool,
+) -> Option<(f64, f64)> {
+    let k1 = kappa * delta0.powf(1.0 - nu);
+    let c1 = c * delta0.powf(-psi);
+    let x = (v * v / k1).powf(1.0 / (nu + 1.0));
+    let (e, tau) = power_collision(nu, psi, c1 * x.powf(psi + 1.0) / v, clamp)?;
+    Some((e, tau * x / v))
+}
+
 /// One pair of materials' coefficients per unit of the contact's reduced mass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PerMass {
@@ -320,7 +413,11 @@ pub fn describe(
     let linear = law.nu == 1.0 && law.psi == 0.0;
     match &law.pairs {
         Some(_) => out.push(format!(
-            "contact: material form ({clamp}): every contact has k = m_eff · k/m of its pair, m_eff its reduced mass (a fixed partner or a wall infinitely heavy)"
+            "contact: material form ({clamp}{}): every contact has k = m_eff · k/m of its pair, m_eff its reduced mass (a fixed partner or a wall infinitely heavy)",
+            match law.impact_speed {
+                Some(v) => format!(", ν = {}, ψ = {}: e and t_c at the impact speed {v}", law.nu, law.psi),
+                None => String::new(),
+            }
         )),
         None if linear => out.push(format!(
             "contact: stiffness form ({clamp}): k_n = {}, γ_n = {}, k_t = {}, γ_t = {}, μ = {}; what they give:",
@@ -357,14 +454,13 @@ pub fn describe(
             match &law.pairs {
                 Some(t) => {
                     let p = t.coeffs[a * t.side + b];
+                    let bounce = match law.collision(&p) {
+                        Some((e, t_c)) => format!("e {e:.3}, t_c {t_c:.3e}"),
+                        None => "no bounce (overdamped)".to_string(),
+                    };
                     let mut line = format!(
-                        "{pair} {}, μ {}; per unit mass k_n {:.4e}, γ_n {:.4e}, k_t {:.4e}, γ_t {:.4e}",
-                        collide(p.k_n, p.gamma_n),
-                        p.mu,
-                        p.k_n,
-                        p.gamma_n,
-                        p.k_t,
-                        p.gamma_t
+                        "{pair} {bounce}, μ {}; per unit mass k_n {:.4e}, γ_n {:.4e}, k_t {:.4e}, γ_t {:.4e}",
+                        p.mu, p.k_n, p.gamma_n, p.k_t, p.gamma_t
                     );
                     for (m, what) in partners {
                         line += &format!(
@@ -406,6 +502,31 @@ mod tests {
                 assert!((t2 - 0.05).abs() < 1e-12, "{clamp} {e}: {t2}");
             }
         }
+    }
+
+    #[test]
+    fn the_power_law_solver_gives_the_linear_closed_forms() {
+        // ν = 1, ψ = 0 is the linear law: the numerical route must land on its closed
+        // forms, whatever the speed and δ0.
+        for clamp in [false, true] {
+            for e in [0.3, 0.75, 0.95] {
+                let (kappa, c) = per_mass(e, 0.05, clamp).unwrap();
+                let (k2, c2) = per_mass_power(e, 0.05, 3.0, (1.0, 0.0, 0.2), clamp).unwrap();
+                assert!(
+                    (k2 / kappa - 1.0).abs() < 1e-6,
+                    "{clamp} {e}: κ {k2} vs {kappa}"
+                );
+                assert!((c2 / c - 1.0).abs() < 1e-6, "{clamp} {e}: c {c2} vs {c}");
+            }
+        }
+        // Hertz round trip, and the speed dependence: t_c ∝ v^(−1/5) without damping.
+        let law = (1.5, 0.5, 0.01);
+        let (k, c) = per_mass_power(0.6, 0.02, 1.0, law, true).unwrap();
+        let (e, t) = collision_power(k, c, 1.0, law, true).unwrap();
+        assert!((e - 0.6).abs() < 1e-9 && (t - 0.02).abs() < 1e-9, "{e} {t}");
+        let (k, _) = per_mass_power(1.0, 0.02, 1.0, law, true).unwrap();
+        let (_, t2) = collision_power(k, 0.0, 32.0, law, true).unwrap();
+        assert!((t2 / 0.02 - 0.5).abs() < 1e-6, "{t2}");
     }
 
     #[test]

@@ -20,6 +20,8 @@ pub struct SpringDashpot {
     /// materials per unit of the contact's reduced mass (src/law/restitution.rs); the
     /// absolute ones above are then unused. None: the stiffness form.
     pub pairs: Option<PairTable>,
+    /// The material form of a nonlinear law: the relative speed at which e and t_c hold.
+    pub impact_speed: Option<f64>,
 }
 
 /// k_t/k_n of the material form when the scene does not say (the ratio of a
@@ -95,6 +97,7 @@ impl SpringDashpot {
             mu: s.mu,
             clamp: s.clamp,
             pairs: None,
+            impact_speed: None,
         })
     }
 
@@ -117,7 +120,6 @@ impl SpringDashpot {
             ("gamma_n", s.gamma_n != 0.0),
             ("k_t", s.k_t != 0.0),
             ("gamma_t", s.gamma_t != 0.0),
-            ("delta0", s.delta0.is_some()),
         ] {
             if given {
                 return Err(SceneError::invalid(
@@ -126,15 +128,49 @@ impl SpringDashpot {
                 ));
             }
         }
-        if s.nu != 1.0 || s.psi != 0.0 {
-            return Err(SceneError::invalid(
-                "contact.restitution",
-                format!(
-                    "the material form is the linear law only (nu = 1, psi = 0; got nu = {}, psi = {}): give k_n and gamma_n for a nonlinear law",
-                    s.nu, s.psi
-                ),
-            ));
-        }
+        // The linear law's e and t_c hold at every speed (closed forms); a nonlinear
+        // law's only at the speed they are asked for, which must then be given.
+        let linear = s.nu == 1.0 && s.psi == 0.0;
+        let power = if linear {
+            for (key, given) in [
+                ("delta0", s.delta0.is_some()),
+                ("impact_speed", s.impact_speed.is_some()),
+            ] {
+                if given {
+                    return Err(SceneError::invalid(
+                        format!("contact.{key}"),
+                        "is for a nonlinear law (nu ≠ 1 or psi ≠ 0): the linear law's restitution and contact time hold at every speed",
+                    ));
+                }
+            }
+            None
+        } else {
+            if !(s.nu >= 1.0 && s.nu <= 3.0 && s.psi >= 0.0 && s.psi <= 3.0) {
+                return Err(SceneError::invalid(
+                    "contact.nu",
+                    format!(
+                        "must be in [1, 3] with psi in [0, 3], got nu = {}, psi = {}",
+                        s.nu, s.psi
+                    ),
+                ));
+            }
+            let Some(delta0) = s.delta0 else {
+                return Err(SceneError::invalid(
+                    "contact.delta0",
+                    "is required when nu ≠ 1 or psi ≠ 0",
+                ));
+            };
+            let Some(v) = s.impact_speed else {
+                return Err(SceneError::invalid(
+                    "contact.impact_speed",
+                    "is required for restitution and contact_time with a nonlinear law (nu ≠ 1 or psi ≠ 0): they hold at that relative speed of a head-on collision only",
+                ));
+            };
+            Some((
+                positive("contact.delta0", delta0)?,
+                positive("contact.impact_speed", v)?,
+            ))
+        };
         let kt_ratio = non_negative("contact.kt_ratio", s.kt_ratio.unwrap_or(DEFAULT_KT_RATIO))?;
         let gt_ratio = non_negative("contact.gamma_t_ratio", s.gamma_t_ratio.unwrap_or(0.0))?;
         let form = super::restitution::MaterialForm {
@@ -145,7 +181,21 @@ impl SpringDashpot {
         };
         let table = super::restitution::pair_table(&form, materials, |at, e, t_c, mu, _, _| {
             let mu = non_negative(&format!("{at}.mu"), mu)?;
-            let (k_n, gamma_n) = super::restitution::resolve_linear(at, e, t_c, s.clamp)?;
+            let (k_n, gamma_n) = match power {
+                None => super::restitution::resolve_linear(at, e, t_c, s.clamp)?,
+                Some((delta0, v)) => {
+                    positive(&format!("{at}.contact_time"), t_c)?;
+                    super::restitution::per_mass_power(e, t_c, v, (s.nu, s.psi, delta0), s.clamp)
+                        .ok_or_else(|| {
+                            SceneError::invalid(
+                                format!("{at}.restitution"),
+                                format!(
+                                    "must be in (0, 1] and reachable by damping the law (got {e})"
+                                ),
+                            )
+                        })?
+                }
+            };
             Ok(PerMass {
                 k_n,
                 gamma_n,
@@ -157,9 +207,10 @@ impl SpringDashpot {
         let base = table.coeffs[0];
         Ok(Self {
             k_n: base.k_n,
-            nu: 1.0,
-            psi: 0.0,
-            delta0: 1.0,
+            nu: s.nu,
+            psi: s.psi,
+            delta0: power.map_or(1.0, |p| p.0),
+            impact_speed: power.map(|p| p.1),
             gamma_n: base.gamma_n,
             k_t: base.k_t,
             gamma_t: base.gamma_t,
@@ -169,17 +220,27 @@ impl SpringDashpot {
         })
     }
 
+    /// The restitution and overlap time of a head-on collision under a pair's
+    /// coefficients (at `impact_speed` for a nonlinear law).
+    pub fn collision(&self, c: &PerMass) -> Option<(f64, f64)> {
+        match self.impact_speed {
+            None => super::restitution::collision(c.k_n, c.gamma_n, self.clamp),
+            Some(v) => super::restitution::collision_power(
+                c.k_n,
+                c.gamma_n,
+                v,
+                (self.nu, self.psi, self.delta0),
+                self.clamp,
+            ),
+        }
+    }
+
     /// The material form's table as the scene records it (`contact.resolved`).
     pub fn resolved(&self, materials: &[String]) -> Vec<ResolvedPair> {
         let Some(t) = &self.pairs else {
             return Vec::new();
         };
-        super::restitution::resolved(
-            t,
-            materials,
-            |_, _, c| super::restitution::collision(c.k_n, c.gamma_n, self.clamp),
-            false,
-        )
+        super::restitution::resolved(t, materials, |_, _, c| self.collision(c), false)
     }
 
     /// The coefficients of one contact: (k_n, γ_n, k_t, γ_t, μ).
@@ -311,6 +372,7 @@ mod tests {
             mu: 0.0,
             clamp: true,
             pairs: None,
+            impact_speed: None,
         };
         let c = ContactInput {
             delta: 0.01,

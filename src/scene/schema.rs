@@ -202,6 +202,11 @@ pub struct SpringDashpotSpec {
     /// How long the surfaces of a head-on collision overlap (time).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contact_time: Option<f64>,
+    /// Material form of a nonlinear law (ν ≠ 1 or ψ ≠ 0): the relative speed of the
+    /// head-on collision whose restitution and contact time are given (they change with
+    /// the speed: Hertz's t_c ∝ v^(−1/5)).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub impact_speed: Option<f64>,
     /// Material form: k_t/k_n (default 2/7) and γ_t/γ_n (default 0).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kt_ratio: Option<f64>,
