@@ -103,25 +103,11 @@ impl OverlapArea {
         materials: &[String],
         corners: &[u32],
     ) -> Result<Self, SceneError> {
-        let (Some(e), Some(t_c)) = (s.restitution, s.contact_time) else {
-            let missing = if s.restitution.is_none() {
-                "restitution"
-            } else {
-                "contact_time"
-            };
-            return Err(SceneError::invalid(
-                format!("contact.{missing}"),
-                "is required with the other of restitution and contact_time (the material form)",
-            ));
-        };
-        for (key, given) in [("k_n", s.k_n.is_some()), ("eta_n", s.eta_n != 0.0)] {
-            if given {
-                return Err(SceneError::invalid(
-                    format!("contact.{key}"),
-                    "belongs to the stiffness form: with restitution and contact_time the law resolves it",
-                ));
-            }
-        }
+        let (e, t_c) = super::restitution::given_pair(s.restitution, s.contact_time)?;
+        super::restitution::refuse(
+            &[("k_n", s.k_n.is_some()), ("eta_n", s.eta_n != 0.0)],
+            "belongs to the stiffness form: with restitution and contact_time the law resolves it",
+        )?;
         let side = materials.len() + 1;
         let form = super::restitution::MaterialForm {
             restitution: e,

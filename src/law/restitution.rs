@@ -192,6 +192,30 @@ pub fn collision_power(
     Some((e, tau * x / v))
 }
 
+/// The first of `keys` given, as the error `contact.KEY: reason`.
+pub fn refuse(keys: &[(&str, bool)], reason: &str) -> Result<(), SceneError> {
+    match keys.iter().find(|(_, given)| *given) {
+        Some((key, _)) => Err(SceneError::invalid(format!("contact.{key}"), reason)),
+        None => Ok(()),
+    }
+}
+
+/// The material form's (e, t_c), both required once either is given.
+pub fn given_pair(e: Option<f64>, t_c: Option<f64>) -> Result<(f64, f64), SceneError> {
+    match (e, t_c) {
+        (Some(e), Some(t_c)) => Ok((e, t_c)),
+        (None, _) => Err(missing("restitution")),
+        (_, None) => Err(missing("contact_time")),
+    }
+}
+
+fn missing(key: &str) -> SceneError {
+    SceneError::invalid(
+        format!("contact.{key}"),
+        "is required with the other of restitution and contact_time (the material form)",
+    )
+}
+
 /// One pair of materials' coefficients per unit of the contact's reduced mass.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct PerMass {

@@ -38,18 +38,14 @@ impl SpringDashpot {
         if s.restitution.is_some() || s.contact_time.is_some() {
             return Self::from_material_form(s, materials);
         }
-        for (key, given) in [
-            ("kt_ratio", s.kt_ratio.is_some()),
-            ("gamma_t_ratio", s.gamma_t_ratio.is_some()),
-            ("pairs", !s.pairs.is_empty()),
-        ] {
-            if given {
-                return Err(SceneError::invalid(
-                    format!("contact.{key}"),
-                    "belongs to the material form: give restitution and contact_time instead of k_n",
-                ));
-            }
-        }
+        super::restitution::refuse(
+            &[
+                ("kt_ratio", s.kt_ratio.is_some()),
+                ("gamma_t_ratio", s.gamma_t_ratio.is_some()),
+                ("pairs", !s.pairs.is_empty()),
+            ],
+            "belongs to the material form: give restitution and contact_time instead of k_n",
+        )?;
         let Some(k_n) = s.k_n else {
             return Err(SceneError::invalid(
                 "contact.k_n",
@@ -104,45 +100,27 @@ impl SpringDashpot {
     /// The material form: e and t_c (and μ) for every pair of materials, resolved into
     /// coefficients per unit of reduced mass (src/law/restitution.rs).
     fn from_material_form(s: &SpringDashpotSpec, materials: &[String]) -> Result<Self, SceneError> {
-        let (Some(e), Some(t_c)) = (s.restitution, s.contact_time) else {
-            let missing = if s.restitution.is_none() {
-                "restitution"
-            } else {
-                "contact_time"
-            };
-            return Err(SceneError::invalid(
-                format!("contact.{missing}"),
-                "is required with the other of restitution and contact_time (the material form)",
-            ));
-        };
-        for (key, given) in [
-            ("k_n", s.k_n.is_some()),
-            ("gamma_n", s.gamma_n != 0.0),
-            ("k_t", s.k_t != 0.0),
-            ("gamma_t", s.gamma_t != 0.0),
-        ] {
-            if given {
-                return Err(SceneError::invalid(
-                    format!("contact.{key}"),
-                    "belongs to the stiffness form: with restitution and contact_time the law resolves it (use kt_ratio and gamma_t_ratio for the tangential spring)",
-                ));
-            }
-        }
+        let (e, t_c) = super::restitution::given_pair(s.restitution, s.contact_time)?;
+        super::restitution::refuse(
+            &[
+                ("k_n", s.k_n.is_some()),
+                ("gamma_n", s.gamma_n != 0.0),
+                ("k_t", s.k_t != 0.0),
+                ("gamma_t", s.gamma_t != 0.0),
+            ],
+            "belongs to the stiffness form: with restitution and contact_time the law resolves it (use kt_ratio and gamma_t_ratio for the tangential spring)",
+        )?;
         // The linear law's e and t_c hold at every speed (closed forms); a nonlinear
         // law's only at the speed they are asked for, which must then be given.
         let linear = s.nu == 1.0 && s.psi == 0.0;
         let power = if linear {
-            for (key, given) in [
-                ("delta0", s.delta0.is_some()),
-                ("impact_speed", s.impact_speed.is_some()),
-            ] {
-                if given {
-                    return Err(SceneError::invalid(
-                        format!("contact.{key}"),
-                        "is for a nonlinear law (nu ≠ 1 or psi ≠ 0): the linear law's restitution and contact time hold at every speed",
-                    ));
-                }
-            }
+            super::restitution::refuse(
+                &[
+                    ("delta0", s.delta0.is_some()),
+                    ("impact_speed", s.impact_speed.is_some()),
+                ],
+                "is for a nonlinear law (nu ≠ 1 or psi ≠ 0): the linear law's restitution and contact time hold at every speed",
+            )?;
             None
         } else {
             if !(s.nu >= 1.0 && s.nu <= 3.0 && s.psi >= 0.0 && s.psi <= 3.0) {
