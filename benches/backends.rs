@@ -22,9 +22,12 @@ fn main() {
         &sizes,
         &polygon_sizes,
         &[1000, 6000],
-        200,
-        None,
-        true,
+        talus::bench::Timing {
+            steps: 200,
+            budget: None,
+            pour: true,
+            kernels: false,
+        },
         &mut |l| eprintln!("{l}"),
     ) {
         Ok(r) => println!("{}", serde_json::to_string_pretty(&r).unwrap()),

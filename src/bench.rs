@@ -51,6 +51,9 @@ pub struct Measurement {
     pub pairs_per_particle: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub contacts_per_particle: Option<f64>,
+    /// GPU path with `--kernels`: device time per kernel and step, the costliest first.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kernels: Option<crate::gpu::KernelTimes>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -198,6 +201,7 @@ fn measure(
     backend: BackendChoice,
     steps: u64,
     budget: Option<f64>,
+    kernels: bool,
 ) -> Result<Measurement, BenchError> {
     let mut e = engine(sim, backend)?;
     let warm = if budget.is_some() { 10 } else { steps / 10 };
@@ -258,6 +262,12 @@ fn measure(
             None,
         ),
     };
+    // After the timing, so that the timestamps cost the figures above nothing. An
+    // adapter without timestamps inside passes gets none (`run` says so).
+    let kernel_times = match &mut e {
+        Engine::Gpu(g) if kernels && g.can_profile() => Some(g.profile(KERNEL_STEPS)?),
+        _ => None,
+    };
     Ok(Measurement {
         workload: workload.into(),
         backend: e.name(),
@@ -280,6 +290,7 @@ fn measure(
         rebuilds_per_1000_steps: rebuilds,
         pairs_per_particle: pairs,
         contacts_per_particle: contacts,
+        kernels: kernel_times,
     })
 }
 
@@ -295,19 +306,34 @@ fn cpu_name() -> String {
         .unwrap_or_else(|| "unknown".into())
 }
 
+/// How each workload is timed.
+#[derive(Clone, Copy, Debug)]
+pub struct Timing {
+    /// Steps timed (after a warm-up), or with `budget` the most steps timed.
+    pub steps: u64,
+    /// Seconds per measurement instead of a fixed step count.
+    pub budget: Option<f64>,
+    /// Also time the reduced R4 pour.
+    pub pour: bool,
+    /// GPU path: also time each kernel (`KERNEL_STEPS` steps with a timestamp after
+    /// every dispatch; `GpuSimulation::profile`).
+    pub kernels: bool,
+}
+
+/// Steps of the profiled run of `Timing::kernels`.
+pub const KERNEL_STEPS: u64 = 128;
+
 /// Runs every workload on every backend; `log` receives one line per measurement. A
 /// workload that cannot run on a backend is recorded in `failures` and the rest go on.
-/// `budget`: seconds per measurement instead of a fixed step count (`steps` at most).
 pub fn run(
     backends: &[BackendChoice],
     sizes: &[usize],
     polygon_sizes: &[usize],
     rod_sizes: &[usize],
-    steps: u64,
-    budget: Option<f64>,
-    pour: bool,
+    timing: Timing,
     log: &mut dyn FnMut(String),
 ) -> Result<Report, BenchError> {
+    let Timing { steps, budget, pour, kernels } = timing;
     let mut results = Vec::new();
     let mut failures = Vec::new();
     // `auto`: the GPU path on a hardware adapter; a software one (lavapipe) only when
@@ -369,7 +395,7 @@ pub fn run(
             } else {
                 steps
             };
-            let m = match measure(name, sim, b, k, budget) {
+            let m = match measure(name, sim, b, k, budget, kernels) {
                 Ok(m) => m,
                 Err(error) => {
                     let backend = format!("{b:?}").to_lowercase();
@@ -409,6 +435,29 @@ pub fn run(
                 m.particle_steps_per_second,
                 m.microseconds_per_step
             ));
+            if kernels && m.kernels.is_none() && m.dispatches_per_step.is_some() {
+                log(format!(
+                    "{:>18} {:>28} no kernel times: the adapter has no timestamps inside passes",
+                    "", ""
+                ));
+            }
+            if let Some(t) = &m.kernels {
+                log(format!(
+                    "{:>18} {:>28} device time per step by kernel ({} steps): {:.0} µs",
+                    "", "", t.steps, t.microseconds_per_step
+                ));
+                for k in &t.kernels {
+                    log(format!(
+                        "{:>18} {:>28} {:>22} {:>9.1} µs {:>5.1} %  {:.2} dispatches",
+                        "",
+                        "",
+                        k.kernel,
+                        k.microseconds_per_step,
+                        100.0 * k.microseconds_per_step / t.microseconds_per_step.max(1e-12),
+                        k.dispatches_per_step
+                    ));
+                }
+            }
             results.push(m);
         }
     }

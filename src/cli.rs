@@ -203,6 +203,10 @@ enum Command {
         /// Also time the reduced R4 pour.
         #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
         pour: bool,
+        /// GPU path: also time each kernel on the device (128 more steps per workload,
+        /// a timestamp after every dispatch; needs the adapter's timestamp queries).
+        #[arg(long)]
+        kernels: bool,
         /// Write the JSON here too (atomically).
         #[arg(long)]
         out: Option<PathBuf>,
@@ -312,13 +316,14 @@ fn command(command: Command, threads: usize) -> ExitCode {
             steps,
             budget,
             pour,
+            kernels,
             out,
         } => cmd_bench(
             &backend,
             (&sizes, &polygon_sizes, &rod_sizes),
-            steps,
-            budget,
+            (steps, budget),
             pour,
+            kernels,
             out,
         ),
     };
@@ -1062,9 +1067,9 @@ const DEFAULT_BUDGET: f64 = 3.0;
 fn cmd_bench(
     backends: &[Backend],
     (sizes, polygon_sizes, rod_sizes): (&[usize], &[usize], &[usize]),
-    steps: Option<u64>,
-    budget: Option<f64>,
+    (steps, budget): (Option<u64>, Option<f64>),
     pour: bool,
+    kernels: bool,
     out: Option<PathBuf>,
 ) -> Result<(), Failure> {
     // A workload is built in memory first: at most 2·10⁷ particles (issue 16: --sizes
@@ -1096,9 +1101,12 @@ fn cmd_bench(
         sizes,
         polygon_sizes,
         rod_sizes,
-        steps,
-        budget,
-        pour,
+        bench::Timing {
+            steps,
+            budget,
+            pour,
+            kernels,
+        },
         &mut |line| eprintln!("{line}"),
     )?;
     let text = serde_json::to_string_pretty(&report).expect("report serialises");

@@ -775,6 +775,41 @@ fn bench_with_a_time_budget_reports_steps_and_microseconds() {
 }
 
 #[test]
+fn bench_kernels_times_each_kernel_of_the_gpu_path() {
+    // --kernels: each GPU workload also gets its device time per kernel (the table
+    // scripts/gpu-check collects on a real GPU); the CPU path has no kernels.
+    let (code, stdout, err) = talus(&[
+        "bench", "--backend", "cpu", "--backend", "gpu", "--sizes", "200", "--polygon-sizes",
+        "30", "--rod-sizes", "20", "--pour", "false", "--steps", "20", "--kernels",
+    ]);
+    if err.contains("no GPU adapter") {
+        assert!(!talus::gpu::device::gpu_required(), "TALUS_REQUIRE_GPU=1 but no adapter");
+        eprintln!("SKIPPED bench --kernels: no adapter");
+        return;
+    }
+    assert_eq!(code, 0, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
+    let results = v["results"].as_array().unwrap();
+    assert_eq!(results.len(), 6, "three workloads on two paths");
+    for r in results {
+        let gpu = r["backend"].as_str().unwrap().starts_with("gpu");
+        if !gpu {
+            assert!(r.get("kernels").is_none(), "{r}");
+            continue;
+        }
+        let t = &r["kernels"];
+        assert_eq!(t["steps"], 128, "{t}");
+        let kernels = t["kernels"].as_array().unwrap();
+        let name = |k: &serde_json::Value| k["kernel"].as_str().unwrap().to_string();
+        assert!(kernels.iter().any(|k| name(k) == "ContactForcesOnly"), "{t}");
+        let sum: f64 = kernels.iter().map(|k| k["microseconds_per_step"].as_f64().unwrap()).sum();
+        let total = t["microseconds_per_step"].as_f64().unwrap();
+        assert!(total > 0.0 && (sum - total).abs() < 1e-6 * total, "{t}");
+    }
+    assert_eq!(err.matches("device time per step by kernel").count(), 3, "{err}");
+}
+
+#[test]
 fn bench_measures_a_software_adapter_only_when_asked() {
     // `auto` (the default with cpu) measures the GPU path on a hardware adapter only;
     // lavapipe would take minutes and measure the CPU again.

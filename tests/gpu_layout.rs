@@ -145,6 +145,7 @@ fn shared_constants_are_the_same_in_rust_and_wgsl() {
         ("LAW_CONTINUOUS", layout::LAW_CONTINUOUS as f64),
         ("LAW_AREA", layout::LAW_AREA as f64),
         ("LAW_HERTZ", layout::LAW_HERTZ as f64),
+        ("LAW_ANY", layout::LAW_ANY as f64),
         ("MAX_SUB", talus::spheropolygon::MAX_SUB as f64),
         ("VERTEX_I", talus::spheropolygon::VERTEX_I as f64),
         ("VERTEX_J", talus::spheropolygon::VERTEX_J as f64),

@@ -124,6 +124,8 @@ pub struct Gpu {
     /// wgpu's default handler would panic; talus notes it here and the run stops with it
     /// at its next check (`GpuSimulation::failure`; issue 16 item 8).
     pub failure: std::sync::Arc<std::sync::Mutex<Option<String>>>,
+    /// Timestamp queries inside compute passes were granted (`GpuSimulation::profile`).
+    pub timestamps: bool,
 }
 
 impl Gpu {
@@ -141,9 +143,12 @@ impl Gpu {
             max_compute_workgroups_per_dimension: have.max_compute_workgroups_per_dimension,
             ..wgpu::Limits::downlevel_defaults()
         };
+        // Timestamps between kernels (`talus bench --kernels`), where the adapter has them.
+        let timing = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
+        let timestamps = adapter.features().contains(timing);
         let desc = wgpu::DeviceDescriptor {
             label: Some("talus"),
-            required_features: wgpu::Features::empty(),
+            required_features: if timestamps { timing } else { wgpu::Features::empty() },
             required_limits: limits.clone(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
@@ -169,6 +174,7 @@ impl Gpu {
             info,
             limits,
             failure,
+            timestamps,
         })
     }
 
@@ -231,9 +237,15 @@ pub fn describe() -> String {
             l.max_buffer_size >> 20,
             l.max_compute_workgroups_per_dimension
         );
+        let timing = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
         let _ = writeln!(
             s,
-            "      features used: none beyond core WebGPU compute (f32, u32 atomics)"
+            "      features used: core WebGPU compute (f32, u32 atomics){}",
+            if a.features().contains(timing) {
+                "; timestamps inside passes (`talus bench --kernels`)"
+            } else {
+                "; no timestamps inside passes (`talus bench --kernels` unavailable)"
+            }
         );
         let binding = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
         let _ = writeln!(

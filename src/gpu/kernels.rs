@@ -339,6 +339,8 @@ pub struct Build {
     /// A software adapter (lavapipe): `contact_forces` takes four pairs to a thread
     /// under the overlap-area law instead of one (`PAIRS_PER_THREAD`, plan.wgsl).
     pub software: bool,
+    /// The contact law (`LAW` in laws.wgsl: `contact_forces` keeps only its code).
+    pub law: u32,
 }
 
 impl Build {
@@ -368,6 +370,7 @@ impl Build {
             walls: !sim.walls.is_empty(),
             swept: matches!(sim.law, crate::law::ContactLaw::HertzCohesive(_)),
             software: adapter.device_type == wgpu::DeviceType::Cpu,
+            law: super::params::law_id(&sim.law),
         }
     }
 }
@@ -443,7 +446,8 @@ impl Pipelines {
                 );
                 let ahead = ("AHEAD", if k == Kernel::CorrectAhead { 1.0 } else { 0.0 });
                 let per_thread = [("PAIRS_PER_THREAD", if build.software { 4.0 } else { 1.0 })];
-                let with_record = [shapes[0], shapes[1], shapes[2], shapes[3], swept, record];
+                let law = ("LAW", build.law as f64);
+                let with_record = [shapes[0], shapes[1], shapes[2], shapes[3], swept, record, law];
                 let constants: &[(&str, f64)] = match module {
                     "find_contacts" => &[polygons, swept],
                     "contact_forces" => &with_record,

@@ -35,6 +35,8 @@ pub const LAW_SPRING_DASHPOT: u32 = 0;
 pub const LAW_CONTINUOUS: u32 = 1;
 pub const LAW_AREA: u32 = 2;
 pub const LAW_HERTZ: u32 = 3;
+/// `LAW` of a pipeline that reads `Params::law` at run time (`LAW_ANY` in laws.wgsl).
+pub const LAW_ANY: u32 = 0xFFFF_FFFF;
 
 /// Words of the control buffer (`C_*` in common.wgsl).
 pub mod control {

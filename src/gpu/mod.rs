@@ -19,6 +19,7 @@
 //! | `step.rs` | encoding steps, pipelined batches, halts |
 //! | `insert.rs` | point sources' candidates, layered rows |
 //! | `transfer.rs` | host ↔ device layouts, download, access for tests |
+//! | `profile.rs` | device time per kernel, from timestamps (`talus bench --kernels`) |
 //! | `buckets.rs` | the hashed grid |
 //! | `device.rs`, `kernels.rs`, `layout.rs`, `position.rs`, `orientation.rs` | adapters, pipelines, shared layouts, fixed point |
 
@@ -33,6 +34,7 @@ pub mod layout;
 pub mod orientation;
 mod params;
 pub mod position;
+mod profile;
 mod step;
 mod transfer;
 
@@ -40,6 +42,7 @@ pub use buckets::{HASH_MIX_1, HASH_MIX_2, HASH_X, HASH_Z, MAX_BUCKETS, bucket, b
 use buffers::{Buffers, Initial};
 use insert::{LayeredBase, SourceBase};
 pub use params::{gpu_pair_side, law_params};
+pub use profile::{KernelTime, KernelTimes, kernel_times};
 pub use step::{BATCHES_IN_FLIGHT, Counters, REBUILD_STAGES, STEPS_PER_SUBMIT, workgroups};
 use step::{dispatch_args, initial_control};
 pub use transfer::{build_table, corner_starts, from_device, table_lookup, to_device};
@@ -109,6 +112,8 @@ pub struct GpuSimulation {
     /// The exact device state read by the last `download`: what a checkpoint of `sim`
     /// carries (`checkpoint_state`).
     downloaded: Option<DeviceState>,
+    /// The timestamps of a profiled run (`profile.rs`), while one is encoded.
+    recorder: std::cell::RefCell<Option<profile::Recorder>>,
 }
 
 /// What a GPU checkpoint adds to the f64 state: the exact device state, so that a GPU
@@ -438,6 +443,7 @@ impl GpuSimulation {
             submissions: Default::default(),
             indirect: Default::default(),
             downloaded: None,
+            recorder: Default::default(),
         })
     }
 

@@ -3,11 +3,21 @@
 
 use super::*;
 
+/// The law's id (`Params::law`, and `LAW` of the contact kernels' pipelines).
+pub fn law_id(law: &ContactLaw) -> u32 {
+    match law {
+        ContactLaw::SpringDashpot(_) => LAW_SPRING_DASHPOT,
+        ContactLaw::OverlapArea(_) => LAW_AREA,
+        ContactLaw::HertzCohesive(_) => LAW_HERTZ,
+        ContactLaw::Continuous(_) => LAW_CONTINUOUS,
+    }
+}
+
 /// Law coefficients into Params (also for the tests that run laws.wgsl on its own).
 pub fn law_params(law: &ContactLaw, p: &mut Params) {
+    p.law = law_id(law);
     match law {
         ContactLaw::SpringDashpot(l) => {
-            p.law = LAW_SPRING_DASHPOT;
             p.k_n = l.k_n as f32;
             p.nu = l.nu as f32;
             p.psi = l.psi as f32;
@@ -21,7 +31,6 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
         }
         ContactLaw::OverlapArea(l) => {
             // η^n and η^t travel in gamma_n and gamma_t (common.wgsl).
-            p.law = LAW_AREA;
             p.k_n = l.k_n as f32;
             p.k_t = l.k_t as f32;
             p.mu = l.mu as f32;
@@ -43,7 +52,6 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
         }
         ContactLaw::HertzCohesive(l) => {
             // γ^N, γ^T are rates: the kernels multiply them by the reduced mass.
-            p.law = LAW_HERTZ;
             p.k_n = l.k_n as f32;
             p.k_t = l.k_t as f32;
             p.gamma_n = l.gamma_n as f32;
@@ -53,7 +61,6 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             p.d_c = l.d_c as f32;
         }
         ContactLaw::Continuous(c) => {
-            p.law = LAW_CONTINUOUS;
             match c.elastic {
                 crate::law::continuous::Elastic::Power { n } => {
                     p.elastic = 0;

@@ -128,6 +128,7 @@ impl GpuSimulation {
         self.dispatches.set(self.dispatches.get() + 1);
         self.set_kernel(pass, k);
         pass.dispatch_workgroups(groups.max(1) as u32, 1, 1);
+        self.mark_kernel(pass, k);
     }
 
     /// Sets a kernel's pipeline and its bind groups (`bindings.rs`: only the buffers it
@@ -153,6 +154,7 @@ impl GpuSimulation {
             self.dispatches.set(self.dispatches.get() + 1);
             self.set_kernel(pass, k);
             pass.dispatch_workgroups_indirect(&self.buffers.dispatch_args, PAIR_ARGS_OFFSET as u64);
+            self.mark_kernel(pass, k);
         } else {
             self.dispatch(pass, k, workgroups(&self.params, k));
         }
@@ -166,6 +168,7 @@ impl GpuSimulation {
         self.set_kernel(pass, k);
         let offset = (REBUILD_STAGES.len() + stage) * DISPATCH_ARGS_BYTES;
         pass.dispatch_workgroups_indirect(&self.buffers.dispatch_args, offset as u64);
+        self.mark_kernel(pass, k);
     }
 
     /// Runs one kernel with a given number of workgroups (tests of the grid-stride
@@ -174,6 +177,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
+            self.mark_start(&mut pass);
             self.dispatch(&mut pass, k, groups);
         }
         self.gpu.queue.submit([enc.finish()]);
@@ -185,6 +189,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
+            self.mark_start(&mut pass);
             for &k in ks {
                 self.encode_kernel(&mut pass, k);
             }
@@ -347,6 +352,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
+            self.mark_start(&mut pass);
             let mut how = first;
             for step in 1..=k {
                 let end = step == k;

@@ -579,6 +579,7 @@ impl GpuSimulation {
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
+            self.mark_start(&mut pass);
             self.encode_kernel(&mut pass, Kernel::ClearTable);
             self.encode_kernel(&mut pass, Kernel::StoreHistory);
         }
