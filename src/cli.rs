@@ -214,6 +214,7 @@ enum Command {
 }
 
 pub fn main() -> ExitCode {
+    quiet_headless_vulkan();
     let cli = Cli::parse();
     let threads = match cli.threads {
         Some(0) => {
@@ -233,6 +234,21 @@ pub fn main() -> ExitCode {
         }
     };
     pool.install(|| command(cli.command, threads))
+}
+
+/// Mesa's Vulkan layer `VK_LAYER_MESA_device_select` looks for a Wayland display to
+/// order the GPUs, and on a machine without a display session libwayland then prints
+/// "error: XDG_RUNTIME_DIR is invalid or not set in the environment" several times per
+/// process, into every log and Slurm output. talus picks its adapter itself
+/// (`device::choose_adapter`), so there the layer is switched off by its own switch,
+/// NODEVICE_SELECT, unless the user chose a device through it (MESA_VK_DEVICE_SELECT) or
+/// set the switch.
+fn quiet_headless_vulkan() {
+    let set = |k: &str| std::env::var_os(k).is_some();
+    if !set("XDG_RUNTIME_DIR") && !set("MESA_VK_DEVICE_SELECT") && !set("NODEVICE_SELECT") {
+        // SAFETY: the first thing `main` does, before any other thread exists.
+        unsafe { std::env::set_var("NODEVICE_SELECT", "1") };
+    }
 }
 
 fn command(command: Command, threads: usize) -> ExitCode {

@@ -775,6 +775,23 @@ fn bench_with_a_time_budget_reports_steps_and_microseconds() {
 }
 
 #[test]
+fn a_headless_machine_gets_no_wayland_noise() {
+    // Without a display session Mesa's device-select layer made libwayland print
+    // "XDG_RUNTIME_DIR is invalid or not set" several times per process (into every
+    // log and Slurm output); talus switches that layer off there.
+    let out = Command::new(env!("CARGO_BIN_EXE_talus"))
+        .arg("info")
+        .env_remove("XDG_RUNTIME_DIR")
+        .env_remove("NODEVICE_SELECT")
+        .env_remove("MESA_VK_DEVICE_SELECT")
+        .output()
+        .expect("binary runs");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(!err.contains("XDG_RUNTIME_DIR"), "{err}");
+}
+
+#[test]
 fn bench_kernels_times_each_kernel_of_the_gpu_path() {
     // --kernels: each GPU workload also gets its device time per kernel (the table
     // scripts/gpu-check collects on a real GPU); the CPU path has no kernels.
