@@ -333,7 +333,12 @@ pub fn run(
     timing: Timing,
     log: &mut dyn FnMut(String),
 ) -> Result<Report, BenchError> {
-    let Timing { steps, budget, pour, kernels } = timing;
+    let Timing {
+        steps,
+        budget,
+        pour,
+        kernels,
+    } = timing;
     let mut results = Vec::new();
     let mut failures = Vec::new();
     // `auto`: the GPU path on a hardware adapter; a software one (lavapipe) only when

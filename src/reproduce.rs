@@ -272,7 +272,8 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproductio
             })
             .collect(),
         // R9 (paper 004): rods of aspect d poured into a box 20 d wide. Reduced: 300 rods
-        // per run, d ∈ {2, 5, 10} at Bo = 0 and Bo ∈ {10², 10³, 10⁴} at d = 5. Full: the
+        // per run, d ∈ {2, 5, 10} at Bo = 0, Bo ∈ {10², 10³, 10⁴} at d = 5, d = 2 at
+        // Bo = 10³ and d = 10 at Bo = 10⁴. Full: the
         // paper's 6000 rods, d ∈ {2, 5, 10} × Bo ∈ {0, 10³, 10⁴}; at Bo = 10⁴ the
         // cohesive pull of k^N = 10⁷ would
         // press contacts by a fifth of a width, so those runs take k^N, k^T 100 times
@@ -343,6 +344,10 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproductio
                     rods(5.0, 100.0),
                     rods(5.0, 1000.0),
                     rods(5.0, 1e4),
+                    // Paper 004 Fig. 4a (Q(r) of d = 2 with and without cohesion) and
+                    // Fig. 5 (principal stress directions of d = 10 at Bo = 0 and 10⁴).
+                    rods(2.0, 1000.0),
+                    rods(10.0, 1e4),
                 ]
             }
         }
@@ -350,54 +355,74 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproductio
     })
 }
 
-/// R9's trends: the packing fraction against d at Bo = 0 and against Bo at d = 5 (runs
-/// named `dD-boB`), each with whether it falls as paper 004 finds.
+/// R9's trends (runs named `dD-boB`), each with whether it falls as paper 004 finds:
+/// the packing fraction against d at Bo = 0 and against Bo at d = 5 (Fig. 2b); the
+/// strength of Q(r)'s maxima and minima against Bo at d = 2 and 5 (Fig. 4); the share of
+/// vertical principal stress directions against Bo at d = 10 (Fig. 5).
 pub fn r9_trends(found: &[Findings]) -> Vec<String> {
-    let phi = |name: &str| {
-        (found.iter())
-            .find(|f| f.variant == name)
-            .map(|f| f.packing_fraction_lower_half)
+    let get = |name: &str, value: &dyn Fn(&Findings) -> Option<f64>| {
+        found.iter().find(|f| f.variant == name).and_then(value)
     };
-    let trend = |what: &str, names: &[(&str, &str)]| -> Option<String> {
-        let values: Vec<f64> = names.iter().map(|(n, _)| phi(n)).collect::<Option<_>>()?;
-        let falls = values.windows(2).all(|w| w[1] < w[0]);
-        let listed: Vec<String> = (names.iter().zip(&values))
-            .map(|((_, label), p)| format!("{label}: {p:.3}"))
+    // The runs of `names` (variant, label) that ran, at least two, and whether the
+    // value falls along them.
+    let trend = |quantity: &str,
+                 value: &dyn Fn(&Findings) -> Option<f64>,
+                 what: &str,
+                 names: Vec<(String, String)>| {
+        let ran: Vec<(String, f64)> = (names.into_iter())
+            .filter_map(|(n, label)| get(&n, value).map(|v| (label, v)))
             .collect();
-        Some(format!(
-            "packing fraction against {what}: {} ({})",
-            listed.join(", "),
-            if falls {
-                "falls, as in paper 004"
-            } else {
-                "does not fall throughout"
-            }
-        ))
+        (ran.len() >= 2).then(|| {
+            let falls = ran.windows(2).all(|w| w[1].1 < w[0].1);
+            let listed: Vec<String> = ran.iter().map(|(l, v)| format!("{l}: {v:.3}")).collect();
+            format!(
+                "{quantity} against {what}: {} ({})",
+                listed.join(", "),
+                if falls {
+                    "falls, as in paper 004"
+                } else {
+                    "does not fall throughout"
+                }
+            )
+        })
     };
+    let phi = |f: &Findings| Some(f.packing_fraction_lower_half);
+    let order = |f: &Findings| f.q_order;
+    let vertical = |f: &Findings| Some(f.vertical_stress_fraction);
+    // Reduced: Bo = 0, 10², 10³, 10⁴ at d = 5; full: 0, 10³, 10⁴ (those that ran).
+    let bonds = |d: u32, list: &[u32]| -> Vec<(String, String)> {
+        (list.iter())
+            .map(|b| (format!("d{d}-bo{b}"), format!("Bo = {b}")))
+            .collect()
+    };
+    let aspects =
+        (([2, 5, 10].iter()).map(|d| (format!("d{d}-bo0"), format!("d = {d}")))).collect();
     let mut out: Vec<String> = [
+        trend("packing fraction", &phi, "d at Bo = 0", aspects),
         trend(
-            "d at Bo = 0",
-            &[
-                ("d2-bo0", "d = 2"),
-                ("d5-bo0", "d = 5"),
-                ("d10-bo0", "d = 10"),
-            ],
+            "packing fraction",
+            &phi,
+            "Bo at d = 5",
+            bonds(5, &[0, 100, 1000, 10000]),
         ),
-        // Reduced: Bo = 0, 10², 10³, 10⁴; full: 0, 10³, 10⁴ (those that ran).
-        {
-            let bonds: Vec<(&str, &str)> = [
-                ("d5-bo0", "Bo = 0"),
-                ("d5-bo100", "Bo = 100"),
-                ("d5-bo1000", "Bo = 1000"),
-                ("d5-bo10000", "Bo = 10000"),
-            ]
-            .into_iter()
-            .filter(|(n, _)| phi(n).is_some())
-            .collect();
-            (bonds.len() >= 2)
-                .then(|| trend("Bo at d = 5", &bonds))
-                .flatten()
-        },
+        trend(
+            "mean |Q(r)|",
+            &order,
+            "Bo at d = 2",
+            bonds(2, &[0, 1000, 10000]),
+        ),
+        trend(
+            "mean |Q(r)|",
+            &order,
+            "Bo at d = 5",
+            bonds(5, &[0, 100, 1000, 10000]),
+        ),
+        trend(
+            "share of principal stress directions within 20° of the vertical",
+            &vertical,
+            "Bo at d = 10",
+            bonds(10, &[0, 1000, 10000]),
+        ),
     ]
     .into_iter()
     .flatten()
@@ -409,11 +434,16 @@ pub fn r9_trends(found: &[Findings]) -> Vec<String> {
             (Some(p), Some(h)) => format!("p_m = {p:.3}, h_s = {h:.3} W"),
             _ => "none (a deposit shallower than half its width)".to_string(),
         };
+        let q = match (f.q_contact, f.q_order) {
+            (Some(c), Some(o)) => format!("{c:.2} at contact, mean |Q| {o:.3}"),
+            _ => "none".to_string(),
+        };
         out.push(format!(
-            "{}: {:.0} % of the rods lie within 20° of the horizontal, {:.0} % stand within 20° of the vertical (uniform: 22 % each); Janssen fit of the mean stress: {fit}",
+            "{}: {:.0} % of the rods lie within 20° of the horizontal, {:.0} % stand within 20° of the vertical (uniform: 22 % each); principal stress within 20° of the vertical: {:.0} % of the rods; Q(r): {q}; Janssen fit of the mean stress: {fit}",
             f.variant,
             100.0 * f.lying_fraction,
             100.0 * f.standing_fraction,
+            100.0 * f.vertical_stress_fraction,
         ));
     }
     out
@@ -456,7 +486,19 @@ pub struct Findings {
     /// units of the stress scale, and the saturation depth h_s in units of the width.
     pub janssen_p_m: Option<f64>,
     pub janssen_h_s: Option<f64>,
+    /// Of the loaded grains, the fraction whose principal stress direction (the larger
+    /// eigenvalue of its own stress) lies within 20° of the vertical (paper 004 Fig. 5;
+    /// uniform: 22 %).
+    pub vertical_stress_fraction: f64,
+    /// Q(r) (paper 004 eq. 2, Fig. 4) of the grains with a long axis: at its first bin
+    /// (contact), and the mean of |Q| over its bins (to 10 mean diameters): how strongly
+    /// its maxima and minima stand out. Bins with fewer than `Q_PAIRS` pairs are left out.
+    pub q_contact: Option<f64>,
+    pub q_order: Option<f64>,
 }
+
+/// Pairs a bin of Q(r) needs to count in `Findings::q_contact` and `q_order`.
+pub const Q_PAIRS: usize = 20;
 
 pub fn findings(variant: &str, a: &Analysis) -> Findings {
     let s = &a.summary;
@@ -529,7 +571,22 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
         }),
         janssen_p_m: janssen(a).map(|j| j.0 / sc),
         janssen_h_s: janssen(a).map(|j| j.1),
+        vertical_stress_fraction: orientation_fraction(&a.principal_directions, |t| {
+            (t - 0.5 * PI).abs() < 20f64.to_radians()
+        }),
+        q_contact: q_bins(&a.correlation).next(),
+        q_order: {
+            let q: Vec<f64> = q_bins(&a.correlation).map(f64::abs).collect();
+            (!q.is_empty()).then(|| q.iter().sum::<f64>() / q.len() as f64)
+        },
     }
+}
+
+/// The values of Q(r)'s bins with at least `Q_PAIRS` pairs, from contact outwards.
+fn q_bins(correlation: &[(f64, f64, usize)]) -> impl Iterator<Item = f64> + '_ {
+    (correlation.iter())
+        .filter(|(_, _, pairs)| *pairs >= Q_PAIRS)
+        .map(|(_, q, _)| *q)
 }
 
 /// Paper 004 Fig. 6: the mean stress p = (σ_xx + σ_zz)/2 of each row of windows (those
@@ -762,6 +819,9 @@ mod tests {
             standing_fraction: 0.0,
             janssen_p_m: None,
             janssen_h_s: None,
+            vertical_stress_fraction: 0.0,
+            q_contact: None,
+            q_order: None,
         }
     }
 
@@ -808,8 +868,47 @@ mod tests {
         let lying = orientation_fraction(&uniform, |t| t.min(PI - t) < 20f64.to_radians());
         assert!((lying - 4.0 / 18.0).abs() < 1e-12, "{lying}");
         assert!(
-            variants("R9", false).unwrap().len() == 6 && variants("R9", true).unwrap().len() == 9
+            variants("R9", false).unwrap().len() == 8 && variants("R9", true).unwrap().len() == 9
         );
+    }
+
+    #[test]
+    fn r9_trends_follow_q_and_the_principal_directions() {
+        let f = |name: &str, q: Option<f64>, vertical: f64| Findings {
+            q_contact: q,
+            q_order: q,
+            vertical_stress_fraction: vertical,
+            ..run(name, Vec::new())
+        };
+        let found = [
+            f("d2-bo0", Some(0.30), 0.5),
+            f("d2-bo1000", Some(0.12), 0.3),
+            f("d5-bo0", Some(0.20), 0.4),
+            f("d5-bo10000", Some(0.25), 0.4),
+            f("d10-bo0", None, 0.6),
+            f("d10-bo10000", None, 0.25),
+        ];
+        let t = r9_trends(&found);
+        let line = |start: &str| {
+            (t.iter().find(|l| l.starts_with(start)))
+                .unwrap_or_else(|| panic!("no {start}: {t:?}"))
+                .clone()
+        };
+        let d2 = line("mean |Q(r)| against Bo at d = 2");
+        assert!(d2.contains("Bo = 1000: 0.120") && d2.contains("falls, as in"), "{d2}");
+        let d5 = line("mean |Q(r)| against Bo at d = 5");
+        assert!(d5.contains("does not fall throughout"), "{d5}");
+        let d10 = line("share of principal stress directions within 20° of the vertical");
+        assert!(d10.contains("Bo = 10000: 0.250") && d10.contains("falls, as in"), "{d10}");
+        let one = line("d2-bo0:");
+        assert!(
+            one.contains("vertical: 50 %") && one.contains("0.30 at contact, mean |Q| 0.300"),
+            "{one}"
+        );
+        assert!(line("d10-bo0:").contains("Q(r): none"));
+        // Q(r)'s bins with too few pairs do not count.
+        let q = [(0.5, 0.9, Q_PAIRS - 1), (1.0, 0.4, Q_PAIRS), (1.5, -0.2, 500)];
+        assert_eq!(q_bins(&q).collect::<Vec<_>>(), vec![0.4, -0.2]);
     }
 
     #[test]

@@ -796,11 +796,28 @@ fn bench_kernels_times_each_kernel_of_the_gpu_path() {
     // --kernels: each GPU workload also gets its device time per kernel (the table
     // scripts/gpu-check collects on a real GPU); the CPU path has no kernels.
     let (code, stdout, err) = talus(&[
-        "bench", "--backend", "cpu", "--backend", "gpu", "--sizes", "200", "--polygon-sizes",
-        "30", "--rod-sizes", "20", "--pour", "false", "--steps", "20", "--kernels",
+        "bench",
+        "--backend",
+        "cpu",
+        "--backend",
+        "gpu",
+        "--sizes",
+        "200",
+        "--polygon-sizes",
+        "30",
+        "--rod-sizes",
+        "20",
+        "--pour",
+        "false",
+        "--steps",
+        "20",
+        "--kernels",
     ]);
     if err.contains("no GPU adapter") {
-        assert!(!talus::gpu::device::gpu_required(), "TALUS_REQUIRE_GPU=1 but no adapter");
+        assert!(
+            !talus::gpu::device::gpu_required(),
+            "TALUS_REQUIRE_GPU=1 but no adapter"
+        );
         eprintln!("SKIPPED bench --kernels: no adapter");
         return;
     }
@@ -818,12 +835,22 @@ fn bench_kernels_times_each_kernel_of_the_gpu_path() {
         assert_eq!(t["steps"], 128, "{t}");
         let kernels = t["kernels"].as_array().unwrap();
         let name = |k: &serde_json::Value| k["kernel"].as_str().unwrap().to_string();
-        assert!(kernels.iter().any(|k| name(k) == "ContactForcesOnly"), "{t}");
-        let sum: f64 = kernels.iter().map(|k| k["microseconds_per_step"].as_f64().unwrap()).sum();
+        assert!(
+            kernels.iter().any(|k| name(k) == "ContactForcesOnly"),
+            "{t}"
+        );
+        let sum: f64 = kernels
+            .iter()
+            .map(|k| k["microseconds_per_step"].as_f64().unwrap())
+            .sum();
         let total = t["microseconds_per_step"].as_f64().unwrap();
         assert!(total > 0.0 && (sum - total).abs() < 1e-6 * total, "{t}");
     }
-    assert_eq!(err.matches("device time per step by kernel").count(), 3, "{err}");
+    assert_eq!(
+        err.matches("device time per step by kernel").count(),
+        3,
+        "{err}"
+    );
 }
 
 #[test]

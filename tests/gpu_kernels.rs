@@ -1134,7 +1134,10 @@ fn profiled_steps_time_every_dispatch_and_change_nothing() {
     // Fast enough that the lists are rebuilt within the run (the rebuild stages then
     // do work in some steps and none in the others).
     for p in v["particles"][0]["particles"].as_array_mut().unwrap() {
-        p["velocity"] = json!([5.0 * p["velocity"][0].as_f64().unwrap(), 5.0 * p["velocity"][1].as_f64().unwrap()]);
+        p["velocity"] = json!([
+            5.0 * p["velocity"][0].as_f64().unwrap(),
+            5.0 * p["velocity"][1].as_f64().unwrap()
+        ]);
     }
     let (Some(mut a), Some(mut b)) = (setup(test, &v), setup(test, &v)) else {
         return;
@@ -1144,7 +1147,10 @@ fn profiled_steps_time_every_dispatch_and_change_nothing() {
     if !a.can_profile() {
         let e = a.profile(10).unwrap_err().to_string();
         assert!(e.contains("timestamp"), "{e}");
-        eprintln!("{test}: {} has no timestamps inside passes; only the refusal checked", a.adapter_name());
+        eprintln!(
+            "{test}: {} has no timestamps inside passes; only the refusal checked",
+            a.adapter_name()
+        );
         return;
     }
     let steps = 150;
@@ -1154,11 +1160,17 @@ fn profiled_steps_time_every_dispatch_and_change_nothing() {
     b.advance(steps).unwrap();
     assert_eq!(a.step(), b.step());
     assert_eq!(a.positions(), b.positions(), "timestamps changed the run");
-    assert!(c.rebuilds > c0.rebuilds, "the scene should rebuild its lists within {steps} steps");
+    assert!(
+        c.rebuilds > c0.rebuilds,
+        "the scene should rebuild its lists within {steps} steps"
+    );
     assert_eq!(t.steps, steps);
     let dispatched = (c.direct + c.indirect - c0.direct - c0.indirect) as f64;
     let charged: f64 = t.kernels.iter().map(|k| k.dispatches_per_step).sum::<f64>() * steps as f64;
-    assert!((charged - dispatched).abs() < 1e-9, "{charged} charged, {dispatched} dispatched");
+    assert!(
+        (charged - dispatched).abs() < 1e-9,
+        "{charged} charged, {dispatched} dispatched"
+    );
     let per_step = |name: &str| {
         (t.kernels.iter().find(|k| k.kernel == name))
             .unwrap_or_else(|| panic!("{name} not timed: {t:?}"))
@@ -1167,13 +1179,23 @@ fn profiled_steps_time_every_dispatch_and_change_nothing() {
     // Every step: the rebuild stages (empty or not), the clock; the contact forces with
     // the outputs only at the last step; Gear predicts at the first only and runs ahead
     // after that.
-    for k in REBUILD_STAGES.iter().chain([&Kernel::AdvanceClock, &Kernel::PlanRebuild]) {
+    for k in REBUILD_STAGES
+        .iter()
+        .chain([&Kernel::AdvanceClock, &Kernel::PlanRebuild])
+    {
         assert_eq!(per_step(&format!("{k:?}")), 1.0, "{k:?}");
     }
     assert_eq!(per_step("ContactForces") * steps as f64, 1.0);
-    assert_eq!(per_step("ContactForcesOnly") * steps as f64, (steps - 1) as f64);
+    assert_eq!(
+        per_step("ContactForcesOnly") * steps as f64,
+        (steps - 1) as f64
+    );
     assert_eq!(per_step("Predict") * steps as f64, 1.0);
     let sum: f64 = t.kernels.iter().map(|k| k.microseconds_per_step).sum();
     assert!(t.microseconds_per_step > 0.0 && (sum - t.microseconds_per_step).abs() < 1e-6);
-    assert!(t.kernels.windows(2).all(|w| w[0].microseconds_per_step >= w[1].microseconds_per_step));
+    assert!(
+        t.kernels
+            .windows(2)
+            .all(|w| w[0].microseconds_per_step >= w[1].microseconds_per_step)
+    );
 }

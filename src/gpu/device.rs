@@ -144,11 +144,16 @@ impl Gpu {
             ..wgpu::Limits::downlevel_defaults()
         };
         // Timestamps between kernels (`talus bench --kernels`), where the adapter has them.
-        let timing = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
+        let timing =
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
         let timestamps = adapter.features().contains(timing);
         let desc = wgpu::DeviceDescriptor {
             label: Some("talus"),
-            required_features: if timestamps { timing } else { wgpu::Features::empty() },
+            required_features: if timestamps {
+                timing
+            } else {
+                wgpu::Features::empty()
+            },
             required_limits: limits.clone(),
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,
@@ -237,7 +242,8 @@ pub fn describe() -> String {
             l.max_buffer_size >> 20,
             l.max_compute_workgroups_per_dimension
         );
-        let timing = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
+        let timing =
+            wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_PASSES;
         let _ = writeln!(
             s,
             "      features used: core WebGPU compute (f32, u32 atomics){}",

@@ -447,7 +447,9 @@ impl Pipelines {
                 let ahead = ("AHEAD", if k == Kernel::CorrectAhead { 1.0 } else { 0.0 });
                 let per_thread = [("PAIRS_PER_THREAD", if build.software { 4.0 } else { 1.0 })];
                 let law = ("LAW", build.law as f64);
-                let with_record = [shapes[0], shapes[1], shapes[2], shapes[3], swept, record, law];
+                let with_record = [
+                    shapes[0], shapes[1], shapes[2], shapes[3], swept, record, law,
+                ];
                 let constants: &[(&str, f64)] = match module {
                     "find_contacts" => &[polygons, swept],
                     "contact_forces" => &with_record,

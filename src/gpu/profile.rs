@@ -90,7 +90,10 @@ impl GpuSimulation {
     fn mark(&self, pass: &mut wgpu::ComputePass, k: Option<Kernel>) {
         if let Some(r) = self.recorder.borrow_mut().as_mut() {
             let index = r.marks.len() as u32;
-            assert!(index < MAX_QUERIES, "more timestamps than one query set holds");
+            assert!(
+                index < MAX_QUERIES,
+                "more timestamps than one query set holds"
+            );
             pass.write_timestamp(&r.set, index);
             r.marks.push(k);
         }
