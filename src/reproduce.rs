@@ -895,11 +895,17 @@ mod tests {
                 .clone()
         };
         let d2 = line("mean |Q(r)| against Bo at d = 2");
-        assert!(d2.contains("Bo = 1000: 0.120") && d2.contains("falls, as in"), "{d2}");
+        assert!(
+            d2.contains("Bo = 1000: 0.120") && d2.contains("falls, as in"),
+            "{d2}"
+        );
         let d5 = line("mean |Q(r)| against Bo at d = 5");
         assert!(d5.contains("does not fall throughout"), "{d5}");
         let d10 = line("share of principal stress directions within 20° of the vertical");
-        assert!(d10.contains("Bo = 10000: 0.250") && d10.contains("falls, as in"), "{d10}");
+        assert!(
+            d10.contains("Bo = 10000: 0.250") && d10.contains("falls, as in"),
+            "{d10}"
+        );
         let one = line("d2-bo0:");
         assert!(
             one.contains("vertical: 50 %") && one.contains("0.30 at contact, mean |Q| 0.300"),
@@ -907,7 +913,11 @@ mod tests {
         );
         assert!(line("d10-bo0:").contains("Q(r): none"));
         // Q(r)'s bins with too few pairs do not count.
-        let q = [(0.5, 0.9, Q_PAIRS - 1), (1.0, 0.4, Q_PAIRS), (1.5, -0.2, 500)];
+        let q = [
+            (0.5, 0.9, Q_PAIRS - 1),
+            (1.0, 0.4, Q_PAIRS),
+            (1.5, -0.2, 500),
+        ];
         assert_eq!(q_bins(&q).collect::<Vec<_>>(), vec![0.4, -0.2]);
     }
 

@@ -135,6 +135,10 @@ pub enum GpuError {
     Readback(String),
     #[error("{0} (use --backend cpu)")]
     Unsupported(String),
+    /// `profile` (talus bench --kernels): the adapter cannot time single kernels, or the
+    /// profiled steps stopped.
+    #[error("kernel times: {0}")]
+    Profile(String),
 }
 
 /// The smallest buffer made: an empty array (a scene without walls or sources) must still

@@ -51,10 +51,9 @@ impl GpuSimulation {
     /// and returns each kernel's device time. `steps` is capped so that the timestamps
     /// fit one query set (about 200 steps).
     pub fn profile(&mut self, steps: u64) -> Result<KernelTimes, GpuError> {
-        if !self.gpu.timestamps {
-            return Err(GpuError::Unsupported(format!(
-                "{} has no timestamp queries inside compute passes, so kernels cannot be \
-                 timed one by one",
+        if !self.can_profile() {
+            return Err(GpuError::Profile(format!(
+                "{} has no timestamp queries inside compute passes",
                 self.gpu.info.name
             )));
         }
@@ -72,7 +71,7 @@ impl GpuSimulation {
         });
         let advanced = self.advance(steps);
         let recorder = self.recorder.borrow_mut().take().expect("the recorder");
-        advanced.map_err(|e| GpuError::Readback(format!("the profiled steps stopped: {e}")))?;
+        advanced.map_err(|e| GpuError::Profile(format!("the profiled steps stopped: {e}")))?;
         let stamps = self.read_timestamps(&recorder)?;
         Ok(kernel_times(&recorder.marks, &stamps, steps))
     }
