@@ -124,6 +124,14 @@ impl Progress {
         }
     }
 
+    /// A warning: printed even when quiet (`-q` silences progress, not problems).
+    pub fn warn(&self, text: &str) {
+        match &self.bar {
+            Some(b) => b.println(text),
+            None => eprintln!("{text}"),
+        }
+    }
+
     pub fn finish(&self) {
         if let Some(b) = &self.bar {
             b.finish_and_clear();

@@ -675,6 +675,24 @@ impl Simulation {
         Ok(())
     }
 
+    /// Each copy's point sources at the current time, in scene order, copy after copy
+    /// (`create::source::progress`), with whether each has stalled.
+    pub fn source_progress(&self) -> Vec<(create::source::SourceProgress, bool)> {
+        let (sources, layered) = creators(&self.scene);
+        let n = sources.len() + layered.len();
+        let (t, dt) = (self.time(), self.scene.dt);
+        let mut out = Vec::new();
+        for c in 0..self.scene.replicas {
+            for (k, spec) in sources.iter().enumerate() {
+                let state = &self.sources[c as usize * n + k];
+                let p = create::source::progress(spec, state, (c, k), t, dt);
+                let stalled = create::source::stalled(&p, spec, t, dt);
+                out.push((p, stalled));
+            }
+        }
+        out
+    }
+
     /// Whether a source or layered block tries to insert at time t.
     fn insertion_due(&self, t: f64) -> bool {
         let (sources, layered) = creators(&self.scene);

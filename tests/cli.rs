@@ -1,6 +1,7 @@
 //! The `talus` binary: bad scenes give a clear error naming the key, exit code 2 and no
 //! panic; a diverging run stops with the step, the particle ids and the checkpoint.
 
+use serde_json::json;
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -772,6 +773,71 @@ fn bench_with_a_time_budget_reports_steps_and_microseconds() {
         assert!((us * steps as f64 / 1e6 - seconds).abs() < 1e-6 * seconds.max(1.0));
     }
     assert_rejected(&["bench", "--budget", "0"], &["--budget"]);
+}
+
+#[test]
+fn a_source_whose_outlet_stays_taken_is_reported() {
+    // A grain resting on the floor right at a source's outlet: the source's first
+    // particle can never be placed. The run ends at stop.time; it must not pass the
+    // empty deposit off as what the scene asked for (stop 32: an R9 pour stalled at 223
+    // of 300 rods without a word).
+    let dir = tmp("stalled-source");
+    let scene = dir.join("scene.json");
+    let text = json!({
+        "name": "stalled",
+        "dt": 0.002,
+        "stop": { "time": 20.0 },
+        "gravity": { "g": [0.0, -1.0] },
+        "domain": { "x": [-5.0, 5.0], "z": [-1.0, 10.0] },
+        "materials": { "m": { "density": 1.0 } },
+        "contact": { "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 10.0, "mu": 0.5 },
+        "walls": [{ "from": [-5.0, 0.0], "to": [5.0, 0.0] }],
+        "particles": [
+            { "kind": "list", "material": "m", "particles": [{ "position": [0.0, 0.5], "diameter": 1.0 }] },
+            { "kind": "point_source", "material": "m", "position": [0.0, 0.5], "spread": 0.0,
+              "rate": 1.0, "count": 5, "diameter": 1.0, "velocity": [0.0, 0.0] }
+        ],
+        "output": { "snapshot_every": 0, "checkpoint_every": 0 }
+    });
+    std::fs::write(&scene, text.to_string()).unwrap();
+    // Both paths: the GPU path's sources advance on the device.
+    for backend in ["cpu", "gpu"] {
+        let out = dir.join(backend);
+        let (code, _, err) = talus(&[
+            "run",
+            scene.to_str().unwrap(),
+            "-q",
+            "--backend",
+            backend,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        if backend == "gpu" && err.contains("no GPU adapter") {
+            assert!(
+                !talus::gpu::device::gpu_required(),
+                "TALUS_REQUIRE_GPU=1: {err}"
+            );
+            eprintln!("SKIPPED the GPU path: no adapter");
+            continue;
+        }
+        assert_eq!(code, 0, "{backend}: {err}");
+        assert!(
+            err.contains("point source 0 placed 0 of its 5 particles")
+                && err.contains("waited since t = 0.0000"),
+            "{backend}: warned even with -q: {err}"
+        );
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let s = &summary["sources"][0];
+        assert_eq!(
+            (s["count"].as_u64(), s["inserted"].as_u64()),
+            (Some(5), Some(0)),
+            "{summary}"
+        );
+        assert_eq!(s["waiting_since"].as_f64(), Some(0.0));
+        assert_eq!(s["next_at"], json!([0.0, 0.5]));
+    }
 }
 
 #[test]

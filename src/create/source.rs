@@ -99,6 +99,49 @@ pub fn due_time(spec: &PointSource, k: u32) -> f64 {
     spec.start_time + k as f64 / spec.rate
 }
 
+/// How far point source `source` of copy `copy` got by time t (the run's summary, and a
+/// warning when it waits): it placed `inserted` of its `count`. `waiting_since` is the
+/// time its next particle fell due, when that was a step or more before t and the
+/// particle is still not placed: its spot at the outlet, `next_at`, has been taken at
+/// every step since (a pile grown up to the outlet, a grain stuck there).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct SourceProgress {
+    pub copy: u32,
+    pub source: usize,
+    pub count: u32,
+    pub inserted: u32,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub waiting_since: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub next_at: Option<[f64; 2]>,
+}
+
+pub fn progress(
+    spec: &PointSource,
+    state: &SourceState,
+    (copy, source): (u32, usize),
+    t: f64,
+    dt: f64,
+) -> SourceProgress {
+    let due = due_time(spec, state.inserted);
+    let waiting = !state.done(spec) && due <= t - dt;
+    let next = (state.pending).unwrap_or_else(|| draw(spec, &mut state.rng.clone()));
+    SourceProgress {
+        copy,
+        source,
+        count: spec.count,
+        inserted: state.inserted,
+        waiting_since: waiting.then_some(due),
+        next_at: waiting.then_some([next.x, spec.position[1]]),
+    }
+}
+
+/// A source has waited long enough to say so: ten of its intervals and a hundred steps.
+pub fn stalled(p: &SourceProgress, spec: &PointSource, t: f64, dt: f64) -> bool {
+    p.waiting_since
+        .is_some_and(|since| t - since >= (10.0 / spec.rate).max(100.0 * dt))
+}
+
 /// Whether the source tries to insert at time t (`emit` is a no-op otherwise).
 pub fn due(spec: &PointSource, state: &SourceState, t: f64) -> bool {
     !state.done(spec) && t >= due_time(spec, state.inserted)
@@ -252,4 +295,49 @@ pub fn emit(
         state.inserted += 1;
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A source of 5 particles at 2 a second from t = 0.
+    fn spec() -> PointSource {
+        let text = serde_json::json!({
+            "name": "s", "dt": 0.001, "stop": { "time": 10.0 }, "gravity": { "g": [0.0, -1.0] },
+            "domain": { "x": [-5.0, 5.0], "z": [-1.0, 10.0] },
+            "materials": { "m": { "density": 1.0 } },
+            "contact": { "law": "spring_dashpot", "k_n": 2000.0, "gamma_n": 10.0, "mu": 0.5 },
+            "particles": [{ "kind": "point_source", "material": "m", "position": [0.0, 5.0],
+                            "spread": 1.0, "rate": 2.0, "count": 5, "diameter": 1.0 }]
+        })
+        .to_string();
+        let scene = crate::scene::parse(&text, &[]).unwrap();
+        match &scene.particles[0] {
+            crate::scene::Creation::PointSource(s) => s.clone(),
+            _ => unreachable!("a point source"),
+        }
+    }
+
+    #[test]
+    fn a_source_waits_once_its_next_particle_is_past_due_and_stalls_after_ten_intervals() {
+        let (spec, dt) = (spec(), 0.01);
+        let mut st = SourceState::new(1, 0);
+        st.inserted = 2; // the next is due at t = 1
+        let at = |st: &SourceState, t: f64| progress(&spec, st, (0, 0), t, dt);
+        // Due this step: not tried yet, so not waiting.
+        assert_eq!(at(&st, 1.0).waiting_since, None);
+        let p = at(&st, 1.0 + 2.0 * dt);
+        assert_eq!(p.waiting_since, Some(1.0));
+        let x = p.next_at.unwrap()[0];
+        assert!((-1.0..=1.0).contains(&x) && p.next_at.unwrap()[1] == 5.0, "{p:?}");
+        assert!(!stalled(&p, &spec, 1.0 + 2.0 * dt, dt));
+        // Ten intervals (5 time units) later it has stalled.
+        assert!(!stalled(&at(&st, 5.9), &spec, 5.9, dt));
+        assert!(stalled(&at(&st, 6.1), &spec, 6.1, dt));
+        // The candidate it waits for is the one `emit` would place next.
+        assert_eq!(upcoming(&spec, &st)[0].x, x);
+        st.inserted = 5;
+        assert_eq!(at(&st, 100.0).waiting_since, None);
+    }
 }

@@ -58,6 +58,10 @@ pub struct RunSummary {
     pub particle_steps_per_second: f64,
     pub final_snapshot: String,
     pub last_checkpoint: Option<String>,
+    /// The point sources: how many particles each placed of its count, and since when
+    /// its next one waits for a free spot at the outlet, if it does.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub sources: Vec<crate::create::source::SourceProgress>,
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -303,6 +307,28 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
     let final_json = snapshot::write(sim, out, "final").map_err(io(out))?;
     let wall = start.elapsed().as_secs_f64();
     let e = sim.energies();
+    let sources = sim.source_progress();
+    // A source that stopped placing its particles (its spot at the outlet taken since
+    // then) leaves a deposit short of what the scene asked for: say so.
+    for (p, _) in sources.iter().filter(|(_, stalled)| *stalled) {
+        let copy = if sim.scene.replicas > 1 {
+            format!("copy {}'s ", p.copy)
+        } else {
+            String::new()
+        };
+        let at = p.next_at.unwrap_or_default();
+        progress.warn(&format!(
+            "talus: warning: {copy}point source {} placed {} of its {} particles: its next one \
+             has waited since t = {:.4} for its spot at the outlet (x = {:.4}, z = {:.4}), \
+             taken at every step since (the deposit reached the outlet, or a grain stuck there)",
+            p.source,
+            p.inserted,
+            p.count,
+            p.waiting_since.unwrap_or_default(),
+            at[0],
+            at[1]
+        ));
+    }
     let summary = RunSummary {
         scene: sim.scene.name.clone(),
         backend,
@@ -318,6 +344,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
         particle_steps_per_second: particle_steps as f64 / wall.max(1e-9),
         final_snapshot: final_json.display().to_string(),
         last_checkpoint: outputs.last_checkpoint().map(|p| p.display().to_string()),
+        sources: sources.into_iter().map(|(p, _)| p).collect(),
     };
     if sim.scene.replicas > 1 {
         write_copies(sim, out, &summary, &settling.copies_settled())?;
@@ -361,6 +388,7 @@ fn write_copies(
             elastic_energy: e.elastic,
             final_snapshot: final_json.display().to_string(),
             last_checkpoint: None,
+            sources: copy.source_progress().into_iter().map(|(p, _)| p).collect(),
             ..whole.clone()
         };
         let text = serde_json::to_string_pretty(&summary).expect("summary serialises");
