@@ -330,7 +330,10 @@ mod tests {
         let p = at(&st, 1.0 + 2.0 * dt);
         assert_eq!(p.waiting_since, Some(1.0));
         let x = p.next_at.unwrap()[0];
-        assert!((-1.0..=1.0).contains(&x) && p.next_at.unwrap()[1] == 5.0, "{p:?}");
+        assert!(
+            (-1.0..=1.0).contains(&x) && p.next_at.unwrap()[1] == 5.0,
+            "{p:?}"
+        );
         assert!(!stalled(&p, &spec, 1.0 + 2.0 * dt, dt));
         // Ten intervals (5 time units) later it has stalled.
         assert!(!stalled(&at(&st, 5.9), &spec, 5.9, dt));
