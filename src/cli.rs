@@ -148,6 +148,11 @@ enum Command {
         /// The paper's size instead of the reduced form.
         #[arg(long)]
         full: bool,
+        /// R9: the paper's layout (as --full) with this many rods instead of 6000, the
+        /// box and the end time sized for them: 1000–3000 rods give a deposit deep
+        /// enough for the Janssen fit in hours of one CPU core, not days.
+        #[arg(long, value_name = "N", conflicts_with = "full")]
+        rods: Option<usize>,
         /// Only the variants whose name contains this (e.g. `wedge-poly`, `seed3`).
         #[arg(long)]
         only: Option<String>,
@@ -297,6 +302,7 @@ fn command(command: Command, threads: usize) -> ExitCode {
         Command::Reproduce {
             id,
             full,
+            rods,
             only,
             reuse: _,
             seeds: Some(seeds),
@@ -310,11 +316,13 @@ fn command(command: Command, threads: usize) -> ExitCode {
                 jobs,
                 threads,
             };
-            sweep::reproduce(&id, full, only.as_deref(), &seeds, out, backend, quiet)
+            let size = reproduction_size(full, rods);
+            sweep::reproduce(&id, size, only.as_deref(), &seeds, out, backend, quiet)
         }
         Command::Reproduce {
             id,
             full,
+            rods,
             only,
             reuse,
             seeds: None,
@@ -322,7 +330,10 @@ fn command(command: Command, threads: usize) -> ExitCode {
             backend,
             quiet,
             ..
-        } => cmd_reproduce(&id, full, only.as_deref(), reuse, out, backend, quiet),
+        } => {
+            let size = reproduction_size(full, rods);
+            cmd_reproduce(&id, size, only.as_deref(), reuse, out, backend, quiet)
+        }
         Command::Sweep(args) => sweep::cmd_sweep(args, threads),
         Command::Bench {
             backend,
@@ -557,13 +568,23 @@ fn finished_run_of(dir: &std::path::Path, scene: &scene::Scene) -> bool {
         && read("scene.json").is_some_and(|s| serde_json::to_value(scene).ok() == Some(s))
 }
 
+/// `--full` and `--rods` as one size (clap refuses both at once).
+fn reproduction_size(full: bool, rods: Option<usize>) -> talus::reproduce::Size {
+    use talus::reproduce::Size;
+    match (rods, full) {
+        (Some(n), _) => Size::Rods(n),
+        (None, true) => Size::Full,
+        (None, false) => Size::Reduced,
+    }
+}
+
 /// The variants of reproduction `id`, those whose name contains `only` if given.
 fn chosen_variants(
     id: &str,
-    full: bool,
+    size: talus::reproduce::Size,
     only: Option<&str>,
 ) -> Result<Vec<talus::reproduce::Variant>, Failure> {
-    let mut variants = talus::reproduce::variants(id, full)?;
+    let mut variants = talus::reproduce::variants(id, size)?;
     if let Some(only) = only {
         let names: Vec<String> = variants.iter().map(|v| v.name.clone()).collect();
         variants.retain(|v| v.name.contains(only));
@@ -579,7 +600,7 @@ fn chosen_variants(
 
 fn cmd_reproduce(
     id: &str,
-    full: bool,
+    size: talus::reproduce::Size,
     only: Option<&str>,
     reuse: bool,
     out: Option<PathBuf>,
@@ -588,7 +609,7 @@ fn cmd_reproduce(
 ) -> Result<(), Failure> {
     use talus::reproduce;
     let id = id.to_uppercase();
-    let variants = chosen_variants(&id, full, only)?;
+    let variants = chosen_variants(&id, size, only)?;
     let root = out.unwrap_or_else(|| PathBuf::from("runs/reproduce").join(&id));
     let interrupt = on_interrupt();
     let mut found = Vec::new();
@@ -743,7 +764,8 @@ fn cmd_reproduce(
     }
     let report = serde_json::json!({
         "id": id,
-        "full": full,
+        "full": size != reproduce::Size::Reduced,
+        "size": size,
         "claim": reproduce::claim(&id),
         "seed_averages": averages,
         "comparisons": comparisons,

@@ -72,13 +72,36 @@ fn v(name: &str, scene: &'static str, overrides: &[&str], window: f64, row: f64)
     }
 }
 
-/// A reproduction that does not exist.
+/// A reproduction that does not exist, or a size it does not have.
 #[derive(Debug, thiserror::Error)]
-#[error("unknown reproduction `{0}`: R1 to R9")]
-pub struct UnknownReproduction(pub String);
+pub enum ReproductionError {
+    #[error("unknown reproduction `{0}`: R1 to R9")]
+    Unknown(String),
+    #[error("--rods: {0} has no rod count (only R9 has)")]
+    NotRods(String),
+    #[error("--rods {0}: R9 needs at least 10 rods")]
+    TooFewRods(usize),
+}
+
+/// How large the runs of a reproduction are.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Size {
+    Reduced,
+    /// The paper's.
+    Full,
+    /// The paper's layout with this many rods, the box and the run sized for them (R9).
+    Rods(usize),
+}
 
 /// The runs of reproduction `id` (R1–R9).
-pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproduction> {
+pub fn variants(id: &str, size: Size) -> Result<Vec<Variant>, ReproductionError> {
+    match size {
+        Size::Rods(_) if id != "R9" => return Err(ReproductionError::NotRods(id.into())),
+        Size::Rods(n) if n < 10 => return Err(ReproductionError::TooFewRods(n)),
+        _ => {}
+    }
+    let full = size != Size::Reduced;
     let r7 = |name: &str, scene: &'static str| v(name, scene, &[], 14.0, 2.0);
     let lattice = |name: &str, set: Vec<String>| {
         let mut x = v(
@@ -280,13 +303,19 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproductio
         // stiffer (δ ~ 10⁻² width) and a step 6 times smaller (the contact time goes as
         // k^(−2/5)).
         "R9" => {
+            let count = match size {
+                Size::Rods(n) => n,
+                _ => 6000,
+            };
             let rods = |d: f64, bond: f64| {
                 let half = 10.0 * d;
                 let mut x = v(&format!("d{d}-bo{bond}"), R9_REDUCED, &[], 4.0 * d, 2.0 * d);
                 // The box's height and the source: above the deposit the run can build
-                // (6000 rods of area (d − 1) + π/4 at a packing fraction of ~0.7).
+                // (`count` rods of area (d − 1) + π/4 at a packing fraction of ~0.7, ~0.4
+                // with cohesion: 0.44–0.6 at 300 rods).
                 let (top, source) = if full {
-                    let deposit = 6000.0 * (d - 1.0 + 0.25 * PI) / (0.7 * 2.0 * half);
+                    let packing = if bond > 0.0 { 0.4 } else { 0.7 };
+                    let deposit = count as f64 * (d - 1.0 + 0.25 * PI) / (packing * 2.0 * half);
                     let top = (deposit + 4.0 * d + 20.0).ceil();
                     (top, top - d - 2.0)
                 } else {
@@ -314,16 +343,23 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproductio
                     ]);
                 }
                 if full {
-                    // 6000 rods due at 60 a second and thrown down at 50 widths a second;
+                    // The rods due at 60 a second and thrown down at 50 widths a second;
                     // a rod waits until the outlet is free within its circumscribed
-                    // circle, which limits the feed (for d = 10, to ~20 a second).
+                    // circle, which limits the feed (for d = 10, to ~20 a second). The
+                    // paper's 6000 rods get 800 time units; fewer get the time to feed
+                    // at 20 a second and 50 more to settle (the cohesive runs do not
+                    // reach the kinetic-drop rule: they run to the end).
+                    let end = match size {
+                        Size::Rods(n) => (n as f64 / 20.0 + 50.0).ceil(),
+                        _ => 800.0,
+                    };
                     x.overrides.extend([
                         "name=r9_rods".to_string(),
-                        "particles[0].count=6000".to_string(),
+                        format!("particles[0].count={count}"),
                         "particles[0].rate=60".to_string(),
                         "particles[0].velocity=[0,-50]".to_string(),
-                        "stop.time=800".to_string(),
-                        format!("output.snapshot_every={}", 50.0),
+                        format!("stop.time={end}"),
+                        format!("output.snapshot_every={}", (end / 16.0).round()),
                     ]);
                 }
                 x
@@ -351,7 +387,7 @@ pub fn variants(id: &str, full: bool) -> Result<Vec<Variant>, UnknownReproductio
                 ]
             }
         }
-        _ => return Err(UnknownReproduction(id.into())),
+        _ => return Err(ReproductionError::Unknown(id.into())),
     })
 }
 
@@ -826,6 +862,35 @@ mod tests {
     }
 
     #[test]
+    fn r9_with_fewer_rods_sizes_the_box_and_the_run_for_them() {
+        let set = |v: &Variant, key: &str| -> String {
+            let hit = v.overrides.iter().rev().find(|o| o.starts_with(key));
+            hit.unwrap_or_else(|| panic!("{}: no {key}", v.name))[key.len()..].to_string()
+        };
+        let find = |all: &[Variant], name: &str| all.iter().find(|v| v.name == name).cloned();
+        let full = variants("R9", Size::Full).unwrap();
+        let some = variants("R9", Size::Rods(1000)).unwrap();
+        assert_eq!(some.len(), full.len());
+        for (name, top) in [("d10-bo0", "130]"), ("d10-bo10000", "183]")] {
+            let v = find(&some, name).unwrap();
+            assert_eq!(set(&v, "particles[0].count="), "1000");
+            // Fed at ~20 a second, then 50 time units to settle.
+            assert_eq!(set(&v, "stop.time="), "100");
+            // 1000 rods of area 9 + π/4 over 200 widths at a packing fraction of 0.7
+            // (0.4 with cohesion), plus 4 d + 20 above them.
+            assert_eq!(set(&v, "walls[1].to="), format!("[-100,{top}"));
+        }
+        let v = find(&full, "d10-bo0").unwrap();
+        assert_eq!(set(&v, "particles[0].count="), "6000");
+        assert_eq!(set(&v, "stop.time="), "800");
+        assert!(matches!(
+            variants("R4", Size::Rods(1000)),
+            Err(ReproductionError::NotRods(..))
+        ));
+        assert!(variants("R9", Size::Rods(9)).is_err());
+    }
+
+    #[test]
     fn the_janssen_fit_finds_the_saturation_depth() {
         let points: Vec<(f64, f64)> = (1..=20)
             .map(|k| {
@@ -868,7 +933,8 @@ mod tests {
         let lying = orientation_fraction(&uniform, |t| t.min(PI - t) < 20f64.to_radians());
         assert!((lying - 4.0 / 18.0).abs() < 1e-12, "{lying}");
         assert!(
-            variants("R9", false).unwrap().len() == 8 && variants("R9", true).unwrap().len() == 9
+            variants("R9", Size::Reduced).unwrap().len() == 8
+                && variants("R9", Size::Full).unwrap().len() == 9
         );
     }
 

@@ -723,6 +723,22 @@ fn reproduce_only_names_the_variants_when_none_matches() {
 }
 
 #[test]
+fn reproduce_rods_is_for_r9_alone() {
+    assert_rejected(
+        &["reproduce", "R4", "--rods", "1000"],
+        &["--rods", "R4", "only R9"],
+    );
+    assert_rejected(
+        &["reproduce", "R9", "--rods", "3"],
+        &["--rods 3", "at least 10"],
+    );
+    assert_rejected(
+        &["reproduce", "R9", "--rods", "1000", "--full"],
+        &["--rods", "--full"],
+    );
+}
+
+#[test]
 fn analyze_rejects_a_reversed_fit_range() {
     assert_rejected(
         &["analyze", "scenes/r1_pile.json", "--fit", "0.9", "0.2"],

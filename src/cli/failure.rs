@@ -9,7 +9,7 @@ use talus::bench::BenchError;
 use talus::checkpoint::CheckpointError;
 use talus::gpu::GpuError;
 use talus::render::RenderError;
-use talus::reproduce::UnknownReproduction;
+use talus::reproduce::ReproductionError;
 use talus::run::RunError;
 use talus::scene::SceneError;
 use talus::sweep::SweepError;
@@ -84,8 +84,8 @@ impl From<CheckpointError> for Failure {
     }
 }
 
-impl From<UnknownReproduction> for Failure {
-    fn from(e: UnknownReproduction) -> Self {
+impl From<ReproductionError> for Failure {
+    fn from(e: ReproductionError) -> Self {
         Self::new(INPUT, e)
     }
 }

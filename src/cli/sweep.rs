@@ -564,7 +564,7 @@ pub struct Seeds {
 /// S_zz profiles in `ROOT/profiles.svg` (seed means with ± one standard deviation).
 pub fn reproduce(
     id: &str,
-    full: bool,
+    size: talus::reproduce::Size,
     only: Option<&str>,
     seeds: &Seeds,
     out: Option<PathBuf>,
@@ -573,7 +573,7 @@ pub fn reproduce(
 ) -> Result<(), Failure> {
     use talus::reproduce;
     let id = id.to_uppercase();
-    let variants = super::chosen_variants(&id, full, only)?;
+    let variants = super::chosen_variants(&id, size, only)?;
     let list = sweep::parse_seeds(&seeds.seeds)?;
     if seeds.jobs == Some(0) {
         return Err(Failure::input("--jobs: must be at least 1, got 0"));
@@ -678,7 +678,8 @@ pub fn reproduce(
     }
     let report = serde_json::json!({
         "id": id,
-        "full": full,
+        "full": size != reproduce::Size::Reduced,
+        "size": size,
         "claim": reproduce::claim(&id),
         "seeds": list,
         "variants": statistics,
