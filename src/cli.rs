@@ -499,6 +499,14 @@ fn cmd_analyze(
         s.coordination.interior,
         s.packing_fraction_lower_half
     );
+    if let Some(j) = &s.janssen {
+        out!(
+            "mean stress against depth (stress_depth.csv): Janssen fit sigma_xx + sigma_zz = sigma_m (1 - exp(-x/h_s)) with sigma_m = {:.3} rho g W, h_s = {:.2} W (slabs to {:.2} W deep)",
+            j.sigma_m,
+            j.h_s,
+            a.stress_depth.last().map_or(0.0, |p| p.0)
+        );
+    }
     if let Some(b) = &s.base_load {
         let (mg, sp) = (b.grain_weight, &b.spread);
         out!(
@@ -731,6 +739,18 @@ fn cmd_reproduce(
             &path,
             &format!("{id}: vertical stress in row 1"),
             &profiles,
+        )?;
+    }
+    let deep: Vec<_> = (found.iter())
+        .filter(|f| f.stress_depth.len() >= 3)
+        .map(|f| (f.variant.clone(), f.stress_depth.clone(), f.janssen))
+        .collect();
+    if !deep.is_empty() {
+        let path = root.join("janssen.svg");
+        talus::render::plots::write_janssen(
+            &path,
+            &format!("{id}: mean stress against depth"),
+            &deep,
         )?;
     }
     for a in &averages {

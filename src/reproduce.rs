@@ -466,9 +466,13 @@ pub fn r9_trends(found: &[Findings]) -> Vec<String> {
     // f(θ): without cohesion long rods lie flat; cohesion makes f(θ) flatter (paper 004
     // Fig. 3): fewer lying, more standing.
     for f in found.iter().filter(|f| f.variant.starts_with('d')) {
-        let fit = match (f.janssen_p_m, f.janssen_h_s) {
-            (Some(p), Some(h)) => format!("p_m = {p:.3}, h_s = {h:.3} W"),
-            _ => "none (a deposit shallower than half its width)".to_string(),
+        let deepest = f.stress_depth.last().map_or(0.0, |p| p.0);
+        let fit = match f.janssen {
+            Some(j) => format!(
+                "sigma_m = {:.3} rho g W, h_s = {:.2} W (slabs to {deepest:.2} W deep)",
+                j.sigma_m, j.h_s
+            ),
+            None => format!("none (slabs to {deepest:.2} W deep; the fit needs 0.5 W)"),
         };
         let q = match (f.q_contact, f.q_order) {
             (Some(c), Some(o)) => format!("{c:.2} at contact, mean |Q| {o:.3}"),
@@ -518,10 +522,11 @@ pub struct Findings {
     /// the horizontal and standing within 20° of the vertical (from f(θ)).
     pub lying_fraction: f64,
     pub standing_fraction: f64,
-    /// The Janssen fit of the mean stress against depth (`janssen`): saturation p_m in
-    /// units of the stress scale, and the saturation depth h_s in units of the width.
-    pub janssen_p_m: Option<f64>,
-    pub janssen_h_s: Option<f64>,
+    /// The trace of the mean stress against depth (`analyze::janssen`: depth / W,
+    /// σ_xx + σ_zz in units of ρ g W), and its Janssen fit: the saturation stress σ_m in
+    /// units of ρ g W and the saturation depth h_s in units of W (paper 004 Fig. 6).
+    pub stress_depth: Vec<(f64, f64)>,
+    pub janssen: Option<crate::analyze::janssen::Janssen>,
     /// Of the loaded grains, the fraction whose principal stress direction (the larger
     /// eigenvalue of its own stress) lies within 20° of the vertical (paper 004 Fig. 5;
     /// uniform: 22 %).
@@ -605,8 +610,8 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
         standing_fraction: orientation_fraction(&a.orientation, |t| {
             (t - 0.5 * PI).abs() < 20f64.to_radians()
         }),
-        janssen_p_m: janssen(a).map(|j| j.0 / sc),
-        janssen_h_s: janssen(a).map(|j| j.1),
+        stress_depth: a.stress_depth.clone(),
+        janssen: s.janssen,
         vertical_stress_fraction: orientation_fraction(&a.principal_directions, |t| {
             (t - 0.5 * PI).abs() < 20f64.to_radians()
         }),
@@ -623,66 +628,6 @@ fn q_bins(correlation: &[(f64, f64, usize)]) -> impl Iterator<Item = f64> + '_ {
     (correlation.iter())
         .filter(|(_, _, pairs)| *pairs >= Q_PAIRS)
         .map(|(_, q, _)| *q)
-}
-
-/// Paper 004 Fig. 6: the mean stress p = (σ_xx + σ_zz)/2 of each row of windows (those
-/// centred in the middle 60 % of the deposit's width), against the depth of the row's
-/// middle below the top in units of the width W, fitted by the Janssen form
-/// p = p_m (1 − exp(−x/h_s)) (`janssen_fit`). None with fewer than three rows, or for a
-/// deposit shallower than half its width (the pressure has not begun to saturate there:
-/// any h_s beyond the depth fits).
-pub fn janssen(a: &Analysis) -> Option<(f64, f64)> {
-    let o = &a.summary.outline;
-    let mut rows: Vec<(f64, f64, usize)> = Vec::new();
-    for w in a.windows.iter().filter(|w| w.particles > 0) {
-        if ((w.x - o.left) / o.width - 0.5).abs() > 0.3 {
-            continue;
-        }
-        let depth = (o.top - 0.5 * (w.z_lo + w.z_hi)) / o.width;
-        let p = 0.5 * (w.sigma.xx + w.sigma.zz);
-        match rows.iter_mut().find(|r| r.2 == w.row) {
-            Some(r) => r.1 += p,
-            None => rows.push((depth, p, w.row)),
-        }
-    }
-    // Each row's mean over its windows.
-    let counts = |row: usize| {
-        (a.windows.iter())
-            .filter(|w| w.row == row && w.particles > 0)
-            .filter(|w| ((w.x - o.left) / o.width - 0.5).abs() <= 0.3)
-            .count() as f64
-    };
-    let points: Vec<(f64, f64)> = (rows.iter())
-        .filter(|r| r.0 > 0.0)
-        .map(|r| (r.0, r.1 / counts(r.2)))
-        .collect();
-    janssen_fit(&points)
-}
-
-/// The Janssen form p = p_m (1 − exp(−x/h_s)) fitted to (x, p): h_s from a scan of 400
-/// log-spaced values in [10⁻³, 10²], p_m by least squares for each. None with fewer than
-/// three points, points shallower than 0.5, or a best h_s at either end of the scan.
-pub fn janssen_fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
-    let deepest = points.iter().map(|p| p.0).fold(0.0, f64::max);
-    if points.len() < 3 || deepest < 0.5 {
-        return None;
-    }
-    let scan: Vec<f64> = (0..400)
-        .map(|k| 10f64.powf(-3.0 + 5.0 * k as f64 / 399.0))
-        .collect();
-    let (_, pm, h, k) = (scan.iter().enumerate())
-        .map(|(k, &h)| {
-            let b: Vec<f64> = points.iter().map(|(x, _)| 1.0 - (-x / h).exp()).collect();
-            let bb: f64 = b.iter().map(|v| v * v).sum();
-            let bp: f64 = b.iter().zip(points).map(|(v, (_, p))| v * p).sum();
-            let pm = bp / bb;
-            let residual: f64 = (b.iter().zip(points))
-                .map(|(v, (_, p))| (p - pm * v).powi(2))
-                .sum();
-            (residual, pm, h, k)
-        })
-        .min_by(|x, y| x.0.total_cmp(&y.0))?;
-    (k > 0 && k + 1 < scan.len()).then_some((pm, h))
 }
 
 use std::f64::consts::PI;
@@ -853,8 +798,8 @@ mod tests {
             base_load_right_max_mg: None,
             lying_fraction: 0.0,
             standing_fraction: 0.0,
-            janssen_p_m: None,
-            janssen_h_s: None,
+            stress_depth: Vec::new(),
+            janssen: None,
             vertical_stress_fraction: 0.0,
             q_contact: None,
             q_order: None,
@@ -888,23 +833,6 @@ mod tests {
             Err(ReproductionError::NotRods(..))
         ));
         assert!(variants("R9", Size::Rods(9)).is_err());
-    }
-
-    #[test]
-    fn the_janssen_fit_finds_the_saturation_depth() {
-        let points: Vec<(f64, f64)> = (1..=20)
-            .map(|k| {
-                let x = 0.1 * k as f64;
-                (x, 2.0 * (1.0 - (-x / 0.4).exp()))
-            })
-            .collect();
-        let (pm, h) = janssen_fit(&points).unwrap();
-        assert!(
-            (pm - 2.0).abs() < 0.02 && (h - 0.4).abs() < 0.02,
-            "{pm} {h}"
-        );
-        // Too shallow to saturate: no fit.
-        assert!(janssen_fit(&points[..4]).is_none());
     }
 
     #[test]

@@ -109,6 +109,32 @@ fn a_resting_column_carries_its_weight_grain_by_grain() {
 }
 
 #[test]
+fn the_stress_against_depth_of_a_column_is_hydrostatic() {
+    // Grain j/2 below the column's top carries m_zz = j m g (above): a slab five
+    // diameters high holds five grains, so its σ_zz is m g × (its centre's depth) / (W ·
+    // d), hydrostatic at the packing fraction π/4 of disks stacked in a column one wide:
+    // in units of ρ g W, σ = (π/4) x with x the depth in widths.
+    let s = settled_column();
+    let a = analyse(&s, &tmp("column-depth"), 1.0);
+    let o = &a.summary.outline;
+    assert!((o.width - 1.0).abs() < 1e-3, "width {}", o.width);
+    let p = &a.stress_depth;
+    // Slabs wholly in the column of 6, every diameter from the top: centres 2.5 and 3.5
+    // deep.
+    assert_eq!(p.len(), 2, "{p:?}");
+    for (k, (x, sigma)) in p.iter().enumerate() {
+        assert!((x - (2.5 + k as f64)).abs() < 2e-3, "{p:?}");
+        let expect = 0.25 * std::f64::consts::PI * x;
+        assert!(
+            (sigma / expect - 1.0).abs() < 2e-3,
+            "{sigma} against {expect}"
+        );
+    }
+    // Two slabs are too few for a Janssen fit.
+    assert!(a.summary.janssen.is_none());
+}
+
+#[test]
 fn a_lattice_pile_has_its_slope_and_the_triangular_packing_fraction() {
     // The reduced R1 pile as built: a 30° triangle of touching disks on a triangular
     // lattice, whose packing fraction is π/(2√3) = 0.9069. Layers two rows high, so that

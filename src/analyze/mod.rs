@@ -3,10 +3,12 @@
 //! the snapshot and its run), `stress` (paper 000 eq. 8–9 and moving averages), `heap`
 //! (outline, free surface, angle of repose, base pressure), `network` (coordination,
 //! force distribution), `structure` (packing fraction, f(θ), Q(r)), `spread` (bootstrap
-//! standard errors of the base load and the stress windows).
+//! standard errors of the base load and the stress windows), `janssen` (the mean stress
+//! against depth and its saturation).
 
 pub mod heap;
 pub mod input;
+pub mod janssen;
 pub mod network;
 pub mod spread;
 pub mod stress;
@@ -148,6 +150,9 @@ pub struct Summary {
     /// heap on a flat base (the virial of the vertical forces), a check on the data.
     pub stress_integral_zz: f64,
     pub weight_times_height: f64,
+    /// The Janssen fit of `stress_depth.csv` (paper 004 Fig. 6; the last snapshot's), when
+    /// the deposit is at least half as deep as it is wide and its stress saturates.
+    pub janssen: Option<janssen::Janssen>,
     /// Snapshots whose stresses (`stress.csv`, `base_profile.csv`) are averaged: 1, or
     /// more with `--from`.
     pub averaged_snapshots: usize,
@@ -179,6 +184,8 @@ pub struct Analysis {
     pub correlation: Vec<(f64, f64, usize)>,
     /// P(φ) of the particles' principal stress directions.
     pub principal_directions: Vec<(f64, f64)>,
+    /// The trace of the mean stress against depth (`janssen::stress_against_depth`).
+    pub stress_depth: Vec<(f64, f64)>,
 }
 
 /// As `analyze`, with the stress tables averaged over `earlier` snapshots as well (same
@@ -320,6 +327,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
         .iter()
         .map(|g| g.mass * input.g * (g.z - o.base))
         .sum();
+    let stress_depth = janssen::stress_against_depth(grains, &moments, &o, density, input.g);
     let summary = Summary {
         snapshot: input.source.display().to_string(),
         scene: input.scene.clone(),
@@ -347,6 +355,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
         energy,
         stress_integral_zz: moments.iter().map(|m| m.zz).sum(),
         weight_times_height: weight_height,
+        janssen: janssen::fit(&stress_depth),
         averaged_snapshots: 1,
         averaged_from_time: input.time,
         options: opt.clone(),
@@ -370,6 +379,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
         orientation,
         correlation,
         principal_directions,
+        stress_depth,
     })
 }
 
@@ -638,6 +648,13 @@ pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, AnalyzeError> {
             a.principal_directions
                 .iter()
                 .map(|&(t, p)| vec![v(t), v(p)]),
+        ),
+    )?;
+    put(
+        "stress_depth.csv",
+        table(
+            &h(&["depth / W", "sigma_xx + sigma_zz / (rho g W)"]),
+            a.stress_depth.iter().map(|&(x, p)| vec![v(x), v(p)]),
         ),
     )?;
     put(

@@ -6,6 +6,7 @@
 
 use super::RenderError;
 use crate::analyze::Analysis;
+use crate::analyze::janssen::Janssen;
 use crate::files::write_atomic;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -276,6 +277,44 @@ pub fn write_profiles(
         title,
         Axis::new("X - X_apex", "heap widths"),
         Axis::new("S_zz(1) = 2 sigma_zz / (rho g h)", "-"),
+        &series,
+    )
+}
+
+/// The trace of the mean stress against depth of several deposits, each beside its
+/// Janssen fit when it has one (paper 004 Fig. 6).
+pub fn write_janssen(
+    path: &Path,
+    title: &str,
+    profiles: &[(String, Vec<(f64, f64)>, Option<Janssen>)],
+) -> Result<(), RenderError> {
+    let mut names = Vec::new();
+    let mut lines = Vec::new();
+    for (name, data, fit) in profiles {
+        names.push(name.clone());
+        lines.push(data.clone());
+        if let Some(j) = fit {
+            let deepest = data.iter().map(|p| p.0).fold(0.0, f64::max);
+            names.push(format!(
+                "{name}: fit, sigma_m {:.3}, h_s {:.2} W",
+                j.sigma_m, j.h_s
+            ));
+            lines.push(
+                (0..=50)
+                    .map(|k| deepest * k as f64 / 50.0)
+                    .map(|x| (x, j.sigma_m * (1.0 - (-x / j.h_s).exp())))
+                    .collect(),
+            );
+        }
+    }
+    let series: Vec<Series> = (names.iter().zip(lines).enumerate())
+        .map(|(k, (name, line))| (name.as_str(), PALETTE[k % PALETTE.len()], line))
+        .collect();
+    plot(
+        path,
+        title,
+        Axis::new("depth / W", "-"),
+        Axis::new("(sigma_xx + sigma_zz) / (rho g W)", "-"),
         &series,
     )
 }
