@@ -153,7 +153,9 @@ enum Command {
         /// enough for the Janssen fit in hours of one CPU core, not days.
         #[arg(long, value_name = "N", conflicts_with = "full")]
         rods: Option<usize>,
-        /// Only the variants whose name contains this (e.g. `wedge-poly`, `seed3`).
+        /// Only the variant of this name, or when none has it those whose name contains
+        /// it (e.g. `wedge-poly`, `seed3`); several separated by commas
+        /// (`d2-bo0,d5-bo1000`).
         #[arg(long)]
         only: Option<String>,
         /// Keep the variants whose folder already holds a finished run of the same
@@ -586,7 +588,7 @@ fn reproduction_size(full: bool, rods: Option<usize>) -> talus::reproduce::Size 
     }
 }
 
-/// The variants of reproduction `id`, those whose name contains `only` if given.
+/// The variants of reproduction `id` that `only` picks (`reproduce::pick`), if given.
 fn chosen_variants(
     id: &str,
     size: talus::reproduce::Size,
@@ -595,7 +597,7 @@ fn chosen_variants(
     let mut variants = talus::reproduce::variants(id, size)?;
     if let Some(only) = only {
         let names: Vec<String> = variants.iter().map(|v| v.name.clone()).collect();
-        variants.retain(|v| v.name.contains(only));
+        variants = talus::reproduce::pick(variants, only);
         if variants.is_empty() {
             return Err(Failure::input(format!(
                 "--only {only}: no variant of {id} matches; they are {}",

@@ -311,10 +311,11 @@ pub fn variants(id: &str, size: Size) -> Result<Vec<Variant>, ReproductionError>
                 let half = 10.0 * d;
                 let mut x = v(&format!("d{d}-bo{bond}"), R9_REDUCED, &[], 4.0 * d, 2.0 * d);
                 // The box's height and the source: above the deposit the run can build
-                // (`count` rods of area (d − 1) + π/4 at a packing fraction of ~0.7, ~0.4
-                // with cohesion: 0.44–0.6 at 300 rods).
+                // (`count` rods of area (d − 1) + π/4 at a packing fraction of ~0.7, and
+                // with cohesion ~0.25: 1000 rods of d = 10 at Bo = 10⁴ packed at 0.27
+                // and, in a box sized for 0.4, stood up to the outlet after 943).
                 let (top, source) = if full {
-                    let packing = if bond > 0.0 { 0.4 } else { 0.7 };
+                    let packing = if bond > 0.0 { 0.25 } else { 0.7 };
                     let deposit = count as f64 * (d - 1.0 + 0.25 * PI) / (packing * 2.0 * half);
                     let top = (deposit + 4.0 * d + 20.0).ceil();
                     (top, top - d - 2.0)
@@ -389,6 +390,29 @@ pub fn variants(id: &str, size: Size) -> Result<Vec<Variant>, ReproductionError>
         }
         _ => return Err(ReproductionError::Unknown(id.into())),
     })
+}
+
+/// The variants `only` picks: each of its comma-separated parts picks the variant of
+/// that name, or, when no variant has that name, those whose name contains it
+/// (`d5-bo1000` is one run, not also `d5-bo10000`; `seed3` every variant of seed 3).
+pub fn pick(variants: Vec<Variant>, only: &str) -> Vec<Variant> {
+    let parts: Vec<&str> = (only.split(',').map(str::trim))
+        .filter(|p| !p.is_empty())
+        .collect();
+    let named = |p: &str| variants.iter().any(|v| v.name == p);
+    let exact: Vec<bool> = parts.iter().map(|p| named(p)).collect();
+    (variants.iter())
+        .filter(|v| {
+            (parts.iter().zip(&exact)).any(|(p, &exact)| {
+                if exact {
+                    v.name == *p
+                } else {
+                    v.name.contains(p)
+                }
+            })
+        })
+        .cloned()
+        .collect()
 }
 
 /// R9's trends (runs named `dD-boB`), each with whether it falls as paper 004 finds:
@@ -807,6 +831,20 @@ mod tests {
     }
 
     #[test]
+    fn only_picks_a_name_exactly_or_else_every_name_containing_it() {
+        let names = |only: &str| -> Vec<String> {
+            let all = variants("R9", Size::Full).unwrap();
+            pick(all, only).into_iter().map(|v| v.name).collect()
+        };
+        assert_eq!(names("d5-bo1000"), ["d5-bo1000"]);
+        assert_eq!(names("d10"), ["d10-bo0", "d10-bo1000", "d10-bo10000"]);
+        assert_eq!(names(" d2-bo0, d5-bo1000 ,"), ["d2-bo0", "d5-bo1000"]);
+        // A part that names no variant matches by containment: Bo = 10³ and 10⁴.
+        assert_eq!(names("bo1000").len(), 6);
+        assert!(names("d7").is_empty() && names(",").is_empty());
+    }
+
+    #[test]
     fn r9_with_fewer_rods_sizes_the_box_and_the_run_for_them() {
         let set = |v: &Variant, key: &str| -> String {
             let hit = v.overrides.iter().rev().find(|o| o.starts_with(key));
@@ -816,13 +854,13 @@ mod tests {
         let full = variants("R9", Size::Full).unwrap();
         let some = variants("R9", Size::Rods(1000)).unwrap();
         assert_eq!(some.len(), full.len());
-        for (name, top) in [("d10-bo0", "130]"), ("d10-bo10000", "183]")] {
+        for (name, top) in [("d10-bo0", "130]"), ("d10-bo10000", "256]")] {
             let v = find(&some, name).unwrap();
             assert_eq!(set(&v, "particles[0].count="), "1000");
             // Fed at ~20 a second, then 50 time units to settle.
             assert_eq!(set(&v, "stop.time="), "100");
             // 1000 rods of area 9 + π/4 over 200 widths at a packing fraction of 0.7
-            // (0.4 with cohesion), plus 4 d + 20 above them.
+            // (0.25 with cohesion), plus 4 d + 20 above them.
             assert_eq!(set(&v, "walls[1].to="), format!("[-100,{top}"));
         }
         let v = find(&full, "d10-bo0").unwrap();

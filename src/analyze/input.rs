@@ -46,6 +46,25 @@ impl Grain {
             .map(|c| c[1])
             .fold(f64::NEG_INFINITY, f64::max)
     }
+    /// Leftmost and rightmost point of the grain's shape.
+    pub fn left(&self) -> f64 {
+        if self.corners.is_empty() {
+            return self.x - self.radius;
+        }
+        self.corners
+            .iter()
+            .map(|c| c[0])
+            .fold(f64::INFINITY, f64::min)
+    }
+    pub fn right(&self) -> f64 {
+        if self.corners.is_empty() {
+            return self.x + self.radius;
+        }
+        self.corners
+            .iter()
+            .map(|c| c[0])
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
 }
 
 /// One contact: the force on `a` (and −force on `b` unless `b` is a wall) acting at

@@ -17,14 +17,17 @@ pub struct Janssen {
     pub h_s: f64,
 }
 
-/// The trace σ_xx + σ_zz of the mean stress against depth below the deposit's top, the
-/// depth in units of its width W and the stress in units of ρ g W (`density` ρ, gravity
-/// `g`). As the paper's representative volume elements of five particle lengths a side
-/// (A_RVE = 5d × 5d), side by side across the width: each point is a slab five mean
-/// particle lengths high (a length being twice the reach: d for a rod, the diameter for
-/// a disk) spanning the deposit, its stress the Σ f ⊗ l (`moments`) of the mobile grains
+/// The trace σ_xx + σ_zz of the mean stress against depth below the deposit's surface,
+/// the depth in units of its width W and the stress in units of ρ g W (`density` ρ,
+/// gravity `g`). W is that of the grains' true shapes (the inner width of the box they
+/// fill); the surface is the mean over bins one particle length wide of the highest
+/// grain top in each (a rough top's highest grain would put the surface above most of
+/// the deposit). As the paper's representative volume elements of five particle lengths
+/// a side (A_RVE = 5d × 5d) side by side across the width, each point is a slab five mean
+/// particle lengths high (a length being twice the reach: d for a rod, the diameter for a
+/// disk) spanning the deposit, its stress the Σ f ⊗ l (`moments`) of the mobile grains
 /// centred in it over its area. Slabs lie in the deposit, centred every particle length
-/// from the top down (so they overlap).
+/// from the surface down (so they overlap).
 pub fn stress_against_depth(
     grains: &[Grain],
     moments: &[Tensor],
@@ -32,26 +35,42 @@ pub fn stress_against_depth(
     density: f64,
     g: f64,
 ) -> Vec<(f64, f64)> {
-    let mobile: Vec<usize> = (0..grains.len()).filter(|&k| !grains[k].fixed).collect();
-    if mobile.is_empty() || o.width <= 0.0 || density * g <= 0.0 {
+    let mobile: Vec<&Grain> = grains.iter().filter(|g| !g.fixed).collect();
+    let left = mobile
+        .iter()
+        .map(|g| g.left())
+        .fold(f64::INFINITY, f64::min);
+    let right = mobile
+        .iter()
+        .map(|g| g.right())
+        .fold(f64::NEG_INFINITY, f64::max);
+    let width = right - left;
+    if mobile.is_empty() || width <= 0.0 || density * g <= 0.0 {
         return Vec::new();
     }
-    let length = mobile.iter().map(|&k| 2.0 * grains[k].radius).sum::<f64>() / mobile.len() as f64;
+    let length = mobile.iter().map(|g| 2.0 * g.radius).sum::<f64>() / mobile.len() as f64;
+    let bins = ((width / length).round() as usize).max(1);
+    let mut tops = vec![f64::NEG_INFINITY; bins];
+    for g in &mobile {
+        let b = ((g.x - left) / width * bins as f64)
+            .floor()
+            .clamp(0.0, (bins - 1) as f64);
+        tops[b as usize] = tops[b as usize].max(g.top());
+    }
+    let tops: Vec<f64> = tops.into_iter().filter(|t| t.is_finite()).collect();
+    let surface = tops.iter().sum::<f64>() / tops.len() as f64;
     let height = 5.0 * length;
-    let unit = density * g * o.width;
+    let unit = density * g * width;
     let mut out = Vec::new();
-    let mut centre = o.top - 0.5 * height;
+    let mut centre = surface - 0.5 * height;
     // A tenth of a length of slack at the base: a deposit's top is its grains' top, below
     // a whole number of lengths by their overlaps.
     while centre - 0.5 * height >= o.base - 0.1 * length {
-        let trace: f64 = (mobile.iter())
-            .filter(|&&k| (grains[k].z - centre).abs() <= 0.5 * height)
-            .map(|&k| moments[k].xx + moments[k].zz)
+        let trace: f64 = (grains.iter().zip(moments))
+            .filter(|(g, _)| !g.fixed && (g.z - centre).abs() <= 0.5 * height)
+            .map(|(_, m)| m.xx + m.zz)
             .sum();
-        out.push((
-            (o.top - centre) / o.width,
-            trace / (o.width * height) / unit,
-        ));
+        out.push(((surface - centre) / width, trace / (width * height) / unit));
         centre -= length;
     }
     out
