@@ -360,10 +360,11 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
     var torque = vec2<f32>(0.0);
     var energy = 0.0;
     var deepest = 0u;
-    // The centre of the sub-contacts' normal forces (src/forces.rs `centre_of_forces`).
-    var weight = 0.0;
-    var weight_abs = 0.0;
-    var centre = vec2<f32>(0.0);
+    // The reported point: the arm l of least-squares F ⊗ l = Σ_k f_k ⊗ l_k, l = (Fᵀ M)/|F|²
+    // with M = Σ_k f_k ⊗ l_k (src/forces.rs `centre_of_forces`): M's columns by l's x, y.
+    var moment_x = vec2<f32>(0.0);
+    var moment_y = vec2<f32>(0.0);
+    var sizes = 0.0;
     for (var k = 0u; k < subs.count; k++) {
         let key = subs.key[k];
         let n = subs.n[k];
@@ -385,9 +386,9 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
         f += fk;
         torque += vec2<f32>(cross2(l1, fk), -cross2(l2, fk));
         energy += r.energy;
-        weight += r.f_n;
-        weight_abs += abs(r.f_n);
-        centre += r.f_n * l1;
+        moment_x += fk * l1.x;
+        moment_y += fk * l1.y;
+        sizes += dot(fk, fk);
         springs.key[k] = key;
         springs.xi[k] = r.history;
         if (subs.delta[k] > subs.delta[deepest]) { deepest = k; }
@@ -402,7 +403,8 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
     if (RECORD || !finite || too_deep) {
         let n = subs.n[deepest];
         var arm = subs.point[deepest] * u;
-        if (abs(weight) > 1.0e-6 * weight_abs) { arm = centre / weight; }
+        let norm = dot(f, f);
+        if (norm > 1.0e-12 * sizes) { arm = vec2<f32>(dot(f, moment_x), dot(f, moment_y)) / norm; }
         contact_info[slot] = vec4<f32>(dot(f, n), dot(f, tangent(n)), delta, energy);
         contact_geo[slot] = vec4<f32>(n, arm);
     }

@@ -287,8 +287,8 @@ pub fn candidate_forces(
 /// force is the sum over its sub-contacts (`spheropolygon::pair_force`), each with its
 /// spring from the list's slot (`NeighbourList::sub_history`). A disk is a point core
 /// swept by its radius; a wall a segment of sweep 0. When recording, a pair is reported
-/// as one contact: its total force, at the centre of its sub-contacts' normal forces
-/// (`centre_of_forces`), with its deepest sub-contact's normal and overlap.
+/// as one contact: its total force, at the point whose Σ f ⊗ l is nearest its
+/// sub-contacts' (`centre_of_forces`), with its deepest sub-contact's normal and overlap.
 fn spheropolygon_candidates(
     s: &StepState,
     law: &HertzCohesive,
@@ -423,20 +423,35 @@ fn spheropolygon_candidate(
     (Some(c), f.springs)
 }
 
-/// The point a spheropolygon pair is reported at: its sub-contacts' points weighted by
-/// their normal forces. Where the sub-contacts' forces are parallel (rods side by side:
-/// one normal) the pair's Σ f ⊗ l and torque are then exactly those of its total force
-/// at that point, so the stress of each grain (paper 000 eq. 8) is that of its
-/// sub-contacts. None when the forces cancel (then: the deepest sub-contact's point).
-/// Twin of the weighting in spheropolygon.wgsl `spheropolygon_force`.
+/// The point a spheropolygon pair is reported at, as an arm from i's centre: the l whose
+/// F ⊗ l comes closest (least squares over the four components) to the pair's
+/// Σ_k f_k ⊗ l_k, with F = Σ_k f_k its total force: l = Σ_k (F·f_k) l_k / |F|². Where
+/// the sub-contacts' forces are parallel (rods side by side without friction: one
+/// normal) F ⊗ l is exactly Σ_k f_k ⊗ l_k, so the stress of each grain (paper 000 eq.
+/// 8) is that of its sub-contacts; otherwise it is the projection of that sum on F's
+/// direction, never larger than the sum itself. (Weighting by the normal forces alone,
+/// as before stop 33, put the tangential force of a cohesive pair whose sub-contacts
+/// push and pull hundreds of rod lengths away.) None when |F|² ≤ 10⁻¹² Σ_k |f_k|²
+/// (then the deepest sub-contact's point: F ⊗ l ≈ 0). Twin of the weighting in
+/// spheropolygon.wgsl `spheropolygon_force`.
 fn centre_of_forces(subs: &[(SubContact, crate::law::ContactOutput)]) -> Option<[f64; 2]> {
-    let (mut w, mut total, mut p) = (0.0, 0.0, [0.0; 2]);
-    for (c, r) in subs {
-        w += r.f_n;
-        total += r.f_n.abs();
-        p = [p[0] + r.f_n * c.arm[0], p[1] + r.f_n * c.arm[1]];
+    let force = |(c, r): &(SubContact, crate::law::ContactOutput)| {
+        let t = tangent(c.n);
+        [r.f_n * c.n[0] + r.f_t * t[0], r.f_n * c.n[1] + r.f_t * t[1]]
+    };
+    let total = subs
+        .iter()
+        .map(force)
+        .fold([0.0; 2], |a, f| [a[0] + f[0], a[1] + f[1]]);
+    let (mut p, mut sizes) = ([0.0; 2], 0.0);
+    for sub in subs {
+        let f = force(sub);
+        let w = total[0] * f[0] + total[1] * f[1];
+        p = [p[0] + w * sub.0.arm[0], p[1] + w * sub.0.arm[1]];
+        sizes += f[0] * f[0] + f[1] * f[1];
     }
-    (w.abs() > 1e-6 * total).then(|| [p[0] / w, p[1] / w])
+    let norm = total[0] * total[0] + total[1] * total[1];
+    (norm > 1e-12 * sizes).then(|| [p[0] / norm, p[1] / norm])
 }
 
 fn candidates_with<L: Law>(
@@ -829,5 +844,76 @@ pub fn reduce_forces(
             acc[1] -= c.force[1];
             acc[2] -= cross([c.arm[0] + d[0], c.arm[1] + d[1]], c.force);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::law::ContactOutput;
+
+    fn sub(n: [f64; 2], arm: [f64; 2], f_n: f64, f_t: f64) -> (SubContact, ContactOutput) {
+        let c = SubContact {
+            key: 0,
+            delta: 0.0,
+            n,
+            arm,
+        };
+        let r = ContactOutput {
+            f_n,
+            f_t,
+            history: 0.0,
+            energy: 0.0,
+        };
+        (c, r)
+    }
+
+    /// Σ_k f_k ⊗ l_k, and F ⊗ l at the reported arm (F the total force).
+    fn moments(subs: &[(SubContact, ContactOutput)]) -> ([[f64; 2]; 2], [[f64; 2]; 2]) {
+        let mut m = [[0.0; 2]; 2];
+        let mut total = [0.0; 2];
+        for (c, r) in subs {
+            let t = tangent(c.n);
+            let f = [r.f_n * c.n[0] + r.f_t * t[0], r.f_n * c.n[1] + r.f_t * t[1]];
+            for a in 0..2 {
+                total[a] += f[a];
+                for b in 0..2 {
+                    m[a][b] += f[a] * c.arm[b];
+                }
+            }
+        }
+        let l = centre_of_forces(subs).unwrap();
+        let reported = [
+            [total[0] * l[0], total[0] * l[1]],
+            [total[1] * l[0], total[1] * l[1]],
+        ];
+        (m, reported)
+    }
+
+    #[test]
+    fn a_pairs_reported_point_keeps_its_stress_exact_or_bounded() {
+        let norm = |m: [[f64; 2]; 2]| m.iter().flatten().map(|v| v * v).sum::<f64>().sqrt();
+        // Rods side by side without friction: one normal, the forces parallel, and one
+        // pushing while the other pulls (cohesion): F ⊗ l is exactly Σ f_k ⊗ l_k.
+        let n = [0.0, 1.0];
+        let (m, got) = moments(&[
+            sub(n, [-2.0, -0.5], 3.0, 0.0),
+            sub(n, [1.5, -0.5], -1.0, 0.0),
+        ]);
+        for (a, b) in m.iter().flatten().zip(got.iter().flatten()) {
+            assert!((a - b).abs() < 1e-12 * norm(m), "{m:?} against {got:?}");
+        }
+        // Pushing and pulling nearly equally, with friction: the normal forces' own
+        // centre would lie 10³ arms away and carry the tangential force there; F ⊗ l is
+        // now never larger than the sum it stands for.
+        let subs = [
+            sub(n, [-2.0, -0.5], 1.0 + 1e-3, 0.4),
+            sub(n, [1.5, -0.5], -1.0, 0.3),
+        ];
+        let (m, got) = moments(&subs);
+        assert!(
+            norm(got) <= norm(m) * (1.0 + 1e-12),
+            "{got:?} against {m:?}"
+        );
     }
 }
