@@ -673,6 +673,15 @@ fn stresses_average_over_snapshots() {
         assert!((a.sigma.zz - 2.0 * b.sigma.zz).abs() <= 1e-12 * b.sigma.zz.abs().max(1e-300));
         assert!((a.sigma.xx - 2.0 * b.sigma.xx).abs() <= 1e-12 + 1e-12 * b.sigma.xx.abs());
     }
+    // So is the stress against depth, slab by slab.
+    assert!(!single.stress_depth.is_empty());
+    assert_eq!(avg.stress_depth.len(), single.stress_depth.len());
+    for (a, b) in avg.stress_depth.iter().zip(&single.stress_depth) {
+        assert!(
+            a.0 == b.0 && (a.1 - 2.0 * b.1).abs() <= 1e-12 * b.1,
+            "{a:?} {b:?}"
+        );
+    }
     assert_eq!(
         avg.summary.forces.mean_normal,
         single.summary.forces.mean_normal

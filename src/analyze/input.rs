@@ -29,41 +29,28 @@ pub struct Grain {
 impl Grain {
     /// Lowest and highest point of the grain's shape.
     pub fn bottom(&self) -> f64 {
-        if self.corners.is_empty() {
-            return self.z - self.radius;
-        }
-        self.corners
-            .iter()
-            .map(|c| c[1])
-            .fold(f64::INFINITY, f64::min)
+        self.extreme(1, f64::min)
     }
     pub fn top(&self) -> f64 {
-        if self.corners.is_empty() {
-            return self.z + self.radius;
-        }
-        self.corners
-            .iter()
-            .map(|c| c[1])
-            .fold(f64::NEG_INFINITY, f64::max)
+        self.extreme(1, f64::max)
     }
     /// Leftmost and rightmost point of the grain's shape.
     pub fn left(&self) -> f64 {
-        if self.corners.is_empty() {
-            return self.x - self.radius;
-        }
-        self.corners
-            .iter()
-            .map(|c| c[0])
-            .fold(f64::INFINITY, f64::min)
+        self.extreme(0, f64::min)
     }
     pub fn right(&self) -> f64 {
+        self.extreme(0, f64::max)
+    }
+    /// The smallest (`pick` = min) or largest (max) coordinate `axis` (0: x, 1: z) of the
+    /// shape: of its corners, or the disk's centre ± radius.
+    fn extreme(&self, axis: usize, pick: fn(f64, f64) -> f64) -> f64 {
+        let centre = [self.x, self.z][axis];
         if self.corners.is_empty() {
-            return self.x + self.radius;
+            return pick(centre - self.radius, centre + self.radius);
         }
-        self.corners
-            .iter()
-            .map(|c| c[0])
-            .fold(f64::NEG_INFINITY, f64::max)
+        (self.corners.iter().map(|c| c[axis]))
+            .reduce(pick)
+            .unwrap_or(centre)
     }
 }
 

@@ -150,8 +150,9 @@ pub struct Summary {
     /// heap on a flat base (the virial of the vertical forces), a check on the data.
     pub stress_integral_zz: f64,
     pub weight_times_height: f64,
-    /// The Janssen fit of `stress_depth.csv` (paper 004 Fig. 6; the last snapshot's), when
-    /// the deposit is at least half as deep as it is wide and its stress saturates.
+    /// The Janssen fit of `stress_depth.csv` (paper 004 Fig. 6; averaged over the snapshots
+    /// with `--from`), when the deposit is at least half as deep as it is wide and its
+    /// stress saturates.
     pub janssen: Option<janssen::Janssen>,
     /// Snapshots whose stresses (`stress.csv`, `base_profile.csv`) are averaged: 1, or
     /// more with `--from`.
@@ -217,7 +218,15 @@ pub fn analyze_series(
         for (acc, x) in a.wall_pressure.iter_mut().zip(&p) {
             acc.1 += x.1;
         }
+        // The slabs of each snapshot below its own surface, in the same places.
+        let depth = janssen::stress_against_depth(&e.grains, &m, &o, a.summary.density, e.g);
+        a.stress_depth.truncate(depth.len());
+        for (acc, x) in a.stress_depth.iter_mut().zip(&depth) {
+            acc.1 += x.1;
+        }
     }
+    a.stress_depth.iter_mut().for_each(|p| p.1 /= n as f64);
+    a.summary.janssen = janssen::fit(&a.stress_depth);
     for w in &mut a.windows {
         w.sigma = w.sigma.scaled(1.0 / n as f64);
         w.particles = (w.particles as f64 / n as f64).round() as usize;
