@@ -485,13 +485,9 @@ fn cmd_analyze(
         a.input.length_unit
     );
     out!(
-        "angle of repose: left {:.1}° (rms {:.2e}, {} points), right {:.1}° (rms {:.2e}, {} points)",
-        s.repose_left.angle_deg,
-        s.repose_left.residual,
-        s.repose_left.points,
-        s.repose_right.angle_deg,
-        s.repose_right.residual,
-        s.repose_right.points
+        "angle of repose: left {}, right {}",
+        s.repose_left,
+        s.repose_right
     );
     out!(
         "coordination: {:.3} all, {:.3} without {} rattlers, {:.3} interior; packing fraction {:.3} (lower half)",
@@ -608,6 +604,16 @@ fn chosen_variants(
     Ok(variants)
 }
 
+/// An angle in degrees for a summary line, or "none" where there was nothing to fit
+/// (a box deposit has no free slope).
+fn degrees(a: f64) -> String {
+    if a.is_finite() {
+        format!("{a:.1}°")
+    } else {
+        "none".to_string()
+    }
+}
+
 fn cmd_reproduce(
     id: &str,
     size: talus::reproduce::Size,
@@ -689,12 +695,12 @@ fn cmd_reproduce(
         talus::render::vtk::write(&a, &dir.join("pictures"))?;
         let f = reproduce::findings(&v.name, &a);
         out!(
-            "{id} {}: {} grains, t = {:.3}; repose {:.1}° / {:.1}°; S_xx/S_zz (row 1, interior) {:.3}; S_zz under the apex / max: base {:.3} / {:.3} (dip {:.2}), row 1 {:.3} / {:.3} (dip {:.2}); Z interior {:.2}",
+            "{id} {}: {} grains, t = {:.3}; repose {} / {}; S_xx/S_zz (row 1, interior) {:.3}; S_zz under the apex / max: base {:.3} / {:.3} (dip {:.2}), row 1 {:.3} / {:.3} (dip {:.2}); Z interior {:.2}",
             v.name,
             f.grains,
             f.time,
-            f.repose_left_deg,
-            f.repose_right_deg,
+            degrees(f.repose_left_deg),
+            degrees(f.repose_right_deg),
             f.stress_ratio_interior_row1,
             f.base_szz_centre,
             f.base_szz_max,

@@ -143,6 +143,23 @@ pub struct Slope {
     pub points: usize,
 }
 
+impl std::fmt::Display for Slope {
+    /// The angle with its fit, or why there is none (a box deposit has no free slope
+    /// between the fitted heights).
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        if self.angle_deg.is_finite() {
+            let (angle, rms, n) = (self.angle_deg, self.residual, self.points);
+            write!(f, "{angle:.1}° (rms {rms:.2e}, {n} points)")
+        } else {
+            write!(
+                f,
+                "none ({} surface points in the fitted band)",
+                self.points
+            )
+        }
+    }
+}
+
 /// Fits both slopes to the surface points whose height above the base lies between
 /// `lo` and `hi` (fractions of the height), which leaves out the apex and the toe.
 pub fn repose(surface: &mut [SurfacePoint], o: &Outline, lo: f64, hi: f64) -> (Slope, Slope) {
@@ -255,4 +272,34 @@ pub fn smoothed_loads(base: &[BaseForce], span: usize) -> Vec<(f64, f64)> {
     (base.iter().zip(super::spread::smooth(&loads, span)))
         .map(|(b, mean)| (b.x, mean))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_slope_prints_its_fit_or_that_there_is_none() {
+        let fitted = Slope {
+            angle_deg: 31.25,
+            residual: 0.012,
+            points: 40,
+        };
+        assert_eq!(fitted.to_string(), "31.2° (rms 1.20e-2, 40 points)");
+        let outline = Outline {
+            base: 0.0,
+            top: 1.0,
+            height: 1.0,
+            left: -1.0,
+            right: 1.0,
+            width: 2.0,
+            apex_x: 0.0,
+        };
+        let (left, right) = repose(&mut [], &outline, 0.2, 0.8);
+        assert_eq!(left.points, 0);
+        assert_eq!(
+            right.to_string(),
+            "none (0 surface points in the fitted band)"
+        );
+    }
 }
