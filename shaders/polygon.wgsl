@@ -1,12 +1,11 @@
-// Overlap-area geometry of convex polygons (src/overlap.rs, SPEC 2.3). Two polygons:
-// each one's edges cut to the part inside the other (`edges_inside`), whose ends are
-// corners or crossings of the outlines (`polygon_polygon`); a polygon and a wall: p's
+// Overlap-area geometry of convex polygons (src/overlap/, SPEC 2.3). Two polygons:
+// each one's edges facing the other cut to the part inside it (`edges_inside`), whose
+// ends are corners or crossings of the outlines (`polygon_polygon`); the twin of
+// src/overlap/polygon.rs, step for step (issue 37 item 1). A polygon and a wall: p's
 // edges cut by the wall's line and the lines across its ends (`polygon_wall`). The
 // line through the two crossings farthest apart gives the normal, its midpoint the
-// force point. src/overlap.rs clips instead (Sutherland-Hodgman, a list of the overlap's
-// corners tagged by origin): the same corners, crossings and area by another route,
-// since a per-thread list is local memory on a GPU (ARCHITECTURE.md, "Polygons on the
-// GPU").
+// force point. (The CPU path also keeps a hint per candidate that lets a resting or
+// apart pair skip the cut, src/overlap/hint.rs; the result is the cut's either way.)
 //
 // Precision (SPEC 3; README "Precision"). Corners are whole position units in a frame
 // at particle j's centre (exact: the fixed-point offset and corners rotated in integers,
@@ -222,11 +221,12 @@ fn crossing_uw(p: ptr<function, Outline>, mp: u32, q: ptr<function, Outline>, mq
 // crossings (an interval of p that starts or ends inside an edge), the corners of each
 // polygon inside the other, and the area, A = 1/2 sum over the intervals of
 // (w_s + w_e)(u_s - u_e) in the frame of the contact line (the trapezoid rule needs
-// each boundary piece's ends, not their order). The quantities are those of
-// src/overlap.rs `polygon_polygon` (its Sutherland-Hodgman clip lists the same corners,
-// crossings and area), so the twin is that function, not its steps: a per-thread list
-// of clipped corners is local memory on a GPU and zeroed and written lane by lane on a
-// software one, while these loops keep everything in registers (issue 14 item 5).
+// each boundary piece's ends, not their order). Only the edges facing each other are
+// cut, by the half-planes facing them (`facing_edges`: along the line of centres u, p's
+// edges reaching beyond q's nearest point and q's reaching short of p's farthest);
+// src/overlap/polygon.rs takes the same steps in f64, and these loops keep everything
+// in registers (a per-thread list of clipped corners is local memory on a GPU, issue
+// 14 item 5).
 
 // Polygon a's edges inside polygon b. Bit e of `pieces`: part of edge e (corner e to
 // the next) lies in b; of `cross`, bit 2e: that part starts at a crossing with b's edge
@@ -324,64 +324,62 @@ fn kept_plane(k: Planes, slot: u32) -> vec4<f32> {
     return select(v, k.p7, slot == 7u);
 }
 
-fn edges_inside(a: ptr<function, Outline>, b: ptr<function, Outline>, h: vec2<i32>,
-                run: bool) -> Inside {
-    var r = Inside(0u, 0u, vec2<u32>(0u), vec2<u32>(0u), 0u, vec2<f32>(0.0), vec2<f32>(0.0), 0.0);
-    let na = select(0u, (*a).n, run);
-    let nb = select(0u, (*b).n, run);
-    // Only the edges of a within b's circle can reach into b, and they are found by
-    // b's half-planes whose lines pass near them: the others hold them all (or none,
-    // and then nothing overlaps). So a few edges are cut by a few half-planes, and
-    // the loops below run over those alone (bit masks), not over all pairs of edges.
-    // (Sutherland-Hodgman in src/overlap.rs skips the same half-planes, `clip_by`.)
-    let cb = centre_at(b, h);
-    let rb = (*b).reach * (1.0 + 1.0e-5);
-    var edges = 0u;
-    var lo = vec2<f32>(3.0e38);
-    var hi = vec2<f32>(-3.0e38);
-    let a0 = corner_at(a, 0u, h);
-    var x = a0;
-    for (var e = 0u; e < na; e++) {
-        var y = a0;
-        if (e + 1u < na) { y = corner_at(a, e + 1u, h); }
-        let d = y - x;
-        let t = clamp(dot(cb - x, d) / max(dot(d, d), 1.0e-30), 0.0, 1.0);
-        let off = x + t * d - cb;
-        if (dot(off, off) <= rb * rb) {
-            edges |= 1u << e;
-            lo = min(lo, min(x, y));
-            hi = max(hi, max(x, y));
-        }
-        x = y;
+// The largest reach of a's corners along u (clip coordinates): `reaches` in
+// src/overlap/polygon.rs.
+fn reach_along(a: ptr<function, Outline>, u: vec2<f32>, h: vec2<i32>) -> f32 {
+    var most = -3.0e38;
+    for (var k = 0u; k < (*a).n; k++) {
+        most = max(most, dot(corner_at(a, k, h), u));
     }
-    if (edges == 0u) { return r; }
-    // A circle holding those edges (about their bounding box), with room for f32
-    // rounding (1e-4 relative, 1e-5 of the polygon): a half-plane that holds all of it
-    // leaves every point of them inside, exactly as cutting by it would.
-    let c = 0.5 * (lo + hi);
-    let rho = 0.5 * length(hi - lo) * (1.0 + 1.0e-4) + 1.0e-5 * (*a).reach;
-    // Those half-planes, the first eight kept in registers: each corner read is a load
-    // of its own (lane by lane on a software adapter), and the cut below reads each
+    return most;
+}
+
+// The edges of a that reach to the far side of the line u.x = t: those with a corner
+// there (`facing_edges` in src/overlap/polygon.rs).
+fn facing_edges(a: ptr<function, Outline>, u: vec2<f32>, t: f32, h: vec2<i32>) -> u32 {
+    let n = (*a).n;
+    var beyond = 0u;
+    for (var k = 0u; k < n; k++) {
+        if (dot(corner_at(a, k, h), u) >= t) { beyond |= 1u << k; }
+    }
+    return beyond | (beyond >> 1u) | ((beyond & 1u) << (n - 1u));
+}
+
+// Whether the point x (clip coordinates) lies inside a, on an edge counting as inside.
+fn contains(a: ptr<function, Outline>, x: vec2<f32>, h: vec2<i32>) -> bool {
+    let n = (*a).n;
+    let a0 = corner_at(a, 0u, h);
+    var c = a0;
+    var inside = true;
+    for (var k = 0u; k < n; k++) {
+        var d = a0;
+        if (k + 1u < n) { d = corner_at(a, k + 1u, h); }
+        inside = inside && cross2(d - c, x - c) >= 0.0;
+        c = d;
+    }
+    return inside;
+}
+
+// The parts of a's edges `edges` inside b, whose half-planes `planes` are the only ones
+// that can cut them (`polygon_polygon` finds both: the edges facing each other).
+fn edges_inside(a: ptr<function, Outline>, edges: u32, b: ptr<function, Outline>, planes: u32,
+                h: vec2<i32>, run: bool) -> Inside {
+    var r = Inside(0u, 0u, vec2<u32>(0u), vec2<u32>(0u), 0u, vec2<f32>(0.0), vec2<f32>(0.0), 0.0);
+    if (!run || edges == 0u) { return r; }
+    // The half-planes, the first eight kept in registers: each corner read is a load of
+    // its own (lane by lane on a software adapter), and the cut below reads each
     // half-plane once per edge.
-    var planes = 0u;
     var kept = Planes(vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0),
                       vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(0.0));
     var n_kept = 0u;
-    let b0 = corner_at(b, 0u, h);
-    var ba = b0;
-    for (var f = 0u; f < nb; f++) {
-        var bb = b0;
-        if (f + 1u < nb) { bb = corner_at(b, f + 1u, h); }
-        let m = vec2<f32>(-(bb.y - ba.y), bb.x - ba.x);
-        let side = dot(c - ba, m);
-        let reach = rho * length(m);
-        if (side <= -reach) { return r; }
-        if (side < reach) {
-            planes |= 1u << f;
-            kept = keep_plane(kept, n_kept, vec4<f32>(ba, m));
-            n_kept++;
-        }
-        ba = bb;
+    var each = planes;
+    while (each != 0u && n_kept < 8u) {
+        let f = firstTrailingBit(each);
+        each &= each - 1u;
+        let ba = corner_at(b, f, h);
+        let bb = corner_at(b, next_corner(b, f), h);
+        kept = keep_plane(kept, n_kept, vec4<f32>(ba, -(bb.y - ba.y), bb.x - ba.x));
+        n_kept++;
     }
     var left = edges;
     while (left != 0u) {
@@ -514,7 +512,19 @@ fn pieces_area(a: ptr<function, Outline>, ins: Inside, a_is_p: bool, fr: Frame,
 // coordinates: f32 units relative to the frame point h. Area in units^2.
 fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2<i32>,
                    ci: vec2<f32>, cj: vec2<f32>) -> AreaContact {
-    let in_p = edges_inside(p, q, h, true);
+    // The edges facing each other along the line of centres u (from i to j): q lies
+    // beyond its nearest reach l_q, p short of its farthest h_p; p's edges reaching
+    // beyond l_q and q's reaching short of h_p are the only ones that meet
+    // (src/overlap/polygon.rs, the twin). Room for f32's rounding of the reaches.
+    var u = vec2<f32>(0.0, 1.0);
+    if (length(cj - ci) > 0.0) { u = (cj - ci) / length(cj - ci); }
+    let h_p = reach_along(p, u, h);
+    let l_q = -reach_along(q, -u, h);
+    let room = 1.0e-5 * (abs(h_p) + abs(l_q)) + 1.0e-6 * (*p).reach;
+    if (h_p < l_q - room) { return no_contact(); }
+    let p_edges = facing_edges(p, u, l_q - room, h);
+    let q_edges = facing_edges(q, -u, -(h_p + room), h);
+    let in_p = edges_inside(p, p_edges, q, q_edges, h, true);
     let n_x = countOneBits(in_p.cross);
     // Two crossings, p entering q at one and leaving it at the other (polygons resting
     // on each other): q's part of the overlap's outline is the chain of q's edges from
@@ -525,7 +535,10 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
     let exits = in_p.cross & 0xAAAAAAAAu;
     let chained = countOneBits(entries) == 1u && countOneBits(exits) == 1u;
     let p_inside = n_x == 0u && in_p.pieces != 0u;
-    let in_q = edges_inside(q, p, h, !chained && !p_inside);
+    // With none of p's outline in q they overlap only if q lies inside p, and then so
+    // does its first corner.
+    let q_in_p = in_p.pieces != 0u || contains(p, corner_at(q, 0u, h), h);
+    let in_q = edges_inside(q, q_edges, p, p_edges, h, !chained && !p_inside && q_in_p);
     if (in_p.pieces == 0u && in_q.pieces == 0u) { return no_contact(); }
     // The chain: q's corners g_out + 1 ... g_in, from the crossing out of q (on q's edge
     // g_out) to the one into it (on q's edge g_in); on one edge, none, or all of q's if
@@ -641,6 +654,8 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
         // More than four crossings: a deep overlap, whose f32 area is good enough.
         g.area = 0.5 * (in_p.area2 + in_q.area2);
     }
+    // (The CPU path counts no overlap thinner than 1e-13 of the radii as a contact,
+    // src/overlap/hint.rs THICKNESS_FLOOR: far below f32's resolution here.)
     if (g.area <= 0.0) { return no_contact(); }
     g.l = reduced_arm(length(g.point - ci), length(g.point - cj), scale);
     return g;

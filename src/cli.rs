@@ -866,11 +866,14 @@ fn cmd_check(
 }
 
 /// `talus check --estimate`: the expected work of the run, and the time it takes on each
-/// backend at the particle-step rate of a few seconds of the scene itself. Timed from
-/// its start: a pour's first steps hold few grains with few contacts, cheaper per
-/// particle than the grown heap's, so for a long pour the estimate leans low (by 3× for
-/// the 50 000-polygon heap, whose grown pile runs at ~1.5·10⁶ per thread).
+/// backend. A scene without point sources is timed as it stands, for a few seconds. A
+/// pour is timed on stand-ins for its grown heap at three sizes up to its final count
+/// (`run::estimate::grown_pile`), and each stretch of the run's expected work is
+/// divided by the rate at its size: timed from its start alone, where a few falling
+/// grains cost less per particle than the heap they grow into, the 50 000-polygon heap
+/// came out 6–7× low (issue 37 item 7).
 fn estimate_run_time(sim: Simulation, backend: Backend) -> Result<(), Failure> {
+    use talus::run::estimate::{self, Rate};
     let total = run::total_steps(&sim);
     let work = run::expected_work(&sim, total);
     out!(
@@ -890,53 +893,110 @@ fn estimate_run_time(sim: Simulation, backend: Backend) -> Result<(), Failure> {
             out!("(no hardware GPU: the CPU path only; --backend gpu times a software adapter)")
         }
     }
-    for b in backends {
-        let start = checkpoint::Checkpoint::fresh(sim.clone());
-        let mut engine = match b {
-            Backend::Gpu => Engine::Gpu(Box::new(GpuSimulation::resume(start)?)),
-            _ => Engine::cpu(start.sim),
-        };
-        // A warm-up, then doubling batches for about 3 s.
-        let warm = 10.min(total);
-        engine
-            .advance(warm)
-            .map_err(|e| Failure::failed(format!("the scene diverged while timed: {e}")))?;
-        let (from, t) = (engine.step(), std::time::Instant::now());
-        let mut batch = 8;
-        while t.elapsed().as_secs_f64() < 3.0 && engine.step() < total {
-            let k = batch.min(total - engine.step());
-            engine
-                .advance(k)
-                .map_err(|e| Failure::failed(format!("the scene diverged while timed: {e}")))?;
-            batch *= 2;
+    let final_count = (0..=10)
+        .map(|k| run::expected_moving(&sim, sim.dt() * (total * k / 10) as f64))
+        .fold(0.0, f64::max);
+    let piles: Vec<(usize, Simulation)> = if final_count > 2.0 * sim.particles.mobile_count() as f64
+    {
+        let mut piles = Vec::new();
+        for n in estimate::pile_sizes(final_count) {
+            let Some(scene) = estimate::grown_pile(&sim.scene, n)? else {
+                break;
+            };
+            piles.push((n, Simulation::new(scene)?));
         }
-        // The GPU runs ahead of the host: a readback waits for it.
-        let _ = engine.sim();
-        let seconds = t.elapsed().as_secs_f64();
-        let done = work.at(engine.step()) - work.at(from);
-        if done <= 0.0 {
+        piles
+    } else {
+        Vec::new()
+    };
+    for b in backends {
+        if piles.is_empty() {
+            let (rate, from, to, name) = time_engine(&sim, b, 3.0, Some(&work))?;
+            let Some(rate) = rate else {
+                out!("{name}: no moving particles in the timed steps; no estimate");
+                continue;
+            };
             out!(
-                "{}: no moving particles in the timed steps; no estimate",
-                engine.name()
+                "{name}: {rate:.3e} particle-steps/s over steps {from}–{to} → about {} for the whole run",
+                duration(work.total() / rate),
             );
             continue;
         }
-        let rate = done / seconds;
-        out!(
-            "{}: {rate:.3e} particle-steps/s over steps {from}–{} → about {} for the whole run{}",
-            engine.name(),
-            engine.step(),
-            duration(work.total() / rate),
-            if engine.step() < total / 2
-                && sim.particles.mobile_count() * 4 < work.total() as usize / total as usize
-            {
-                " (timed while the scene is still small: the grown heap costs more per particle, so this leans low)"
-            } else {
-                ""
+        let (mut rates, mut name) = (Vec::new(), String::new());
+        for (n, pile) in &piles {
+            let (rate, _, to, engine) = time_engine(pile, b, 2.0, None)?;
+            name = engine;
+            if let Some(r) = rate {
+                let moving = pile.particles.mobile_count() as f64;
+                out!(
+                    "{name}: the heap grown to {n} (a lattice pile of {} moving, at rest): {r:.3e} particle-steps/s over {to} steps",
+                    moving as usize
+                );
+                rates.push(Rate {
+                    particles: moving,
+                    per_second: r,
+                });
             }
+        }
+        if rates.is_empty() {
+            out!("{name}: the stand-in piles did not move; no estimate");
+            continue;
+        }
+        let (lo, hi) = (rates.iter())
+            .map(|r| r.per_second)
+            .fold((f64::INFINITY, 0.0f64), |(a, b), r| (a.min(r), b.max(r)));
+        out!(
+            "{name}: {lo:.3e}–{hi:.3e} particle-steps/s as the heap grows → about {} for the whole run (its expected work at the rate of the heap at its size, step range by step range)",
+            duration(estimate::run_time(&work, &rates))
         );
     }
     Ok(())
+}
+
+/// `sim` on backend b for about `seconds` after a warm-up of 10 steps, in doubling
+/// batches: its rate (particle-steps/s; None if nothing moved), the steps timed and the
+/// engine's name. With
+/// `work`, the run's expected work over those steps, up to its stop time; without (a
+/// stand-in pile), its moving particles times the steps, whatever its stop time.
+fn time_engine(
+    sim: &Simulation,
+    b: Backend,
+    seconds: f64,
+    work: Option<&talus::progress::Work>,
+) -> Result<(Option<f64>, u64, u64, String), Failure> {
+    let total = run::total_steps(sim).max(1);
+    let start = checkpoint::Checkpoint::fresh(sim.clone());
+    let mut engine = match b {
+        Backend::Gpu => Engine::Gpu(Box::new(GpuSimulation::resume(start)?)),
+        _ => Engine::cpu(start.sim),
+    };
+    let diverged = |e| Failure::failed(format!("the scene diverged while timed: {e}"));
+    engine.advance(10.min(total)).map_err(diverged)?;
+    let (from, t) = (engine.step(), std::time::Instant::now());
+    let mut batch = 8;
+    let limit = if work.is_some() { total } else { u64::MAX };
+    while t.elapsed().as_secs_f64() < seconds && engine.step() < limit {
+        let k = batch.min(limit - engine.step());
+        engine.advance(k).map_err(diverged)?;
+        batch *= 2;
+    }
+    // The GPU runs ahead of the host: a readback waits for it.
+    let moving = (engine.sim())
+        .map_err(|e| Failure::failed(format!("the device was lost while timed: {e}")))?
+        .particles
+        .mobile_count() as f64;
+    let seconds = t.elapsed().as_secs_f64();
+    let to = engine.step();
+    let done = match work {
+        Some(w) => w.at(to) - w.at(from),
+        None => moving * (to - from) as f64,
+    };
+    Ok((
+        (done > 0.0).then(|| done / seconds),
+        from,
+        to,
+        engine.name(),
+    ))
 }
 
 /// A duration in words: seconds, minutes, hours or days.

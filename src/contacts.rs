@@ -39,18 +39,16 @@ pub fn circles_touch(
     pair: Pair,
 ) -> bool {
     let i = pair.i as usize;
-    let g = if pair.is_wall() {
+    if pair.is_wall() {
         let wall = &walls[(pair.j - WALL_BASE) as usize];
-        disk_wall(particles.radius[i], &wall_from(wall, particles.position(i)))
-    } else {
-        let j = pair.j as usize;
-        disk_disk(
-            offset(particles, i, j),
-            particles.radius[i],
-            particles.radius[j],
-        )
-    };
-    !g.r.is_nan() && g.r < range_factor * g.sigma
+        let g = disk_wall(particles.radius[i], &wall_from(wall, particles.position(i)));
+        return !g.r.is_nan() && g.r < range_factor * g.sigma;
+    }
+    // |d| < range (r_i + r_j), squared: no square root (a NaN compares false).
+    let j = pair.j as usize;
+    let d = offset(particles, i, j);
+    let reach = range_factor * (particles.radius[i] + particles.radius[j]);
+    d[0] * d[0] + d[1] * d[1] < reach * reach
 }
 
 /// Whether particles i and j interact: disks within `range_factor` · σ, polygons whose

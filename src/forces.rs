@@ -15,7 +15,8 @@ use crate::law::hertz_cohesive::HertzCohesive;
 use crate::law::{ContactInput, ContactLaw, ContactOutput, Law};
 use crate::neighbours::{NeighbourList, id_pair};
 use crate::overlap::{
-    AreaContact, disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon, polygon_wall,
+    AreaContact, Hint, disk_disk_area, disk_wall_area, polygon_disk, polygon_polygon_hinted,
+    polygon_wall,
 };
 use crate::shape::RotatedCorners;
 use crate::spheropolygon::{SubContact, SubSprings};
@@ -147,30 +148,46 @@ pub fn candidate_force<L: Law>(
     pair: Pair,
     history: f64,
 ) -> Option<(ContactForce, f64)> {
-    let (g, input) = if L::AREA {
-        if !crate::contacts::circles_touch(s.particles, s.walls, law.range_factor(), pair) {
-            return None;
+    candidate_force_hinted(s, law, pair, history, Hint::NONE).0
+}
+
+/// [`candidate_force`] from the candidate's hint of its last evaluation (polygon pairs,
+/// `overlap::Hint`: the same result to the bit, with less work), and its hint for the
+/// next.
+#[inline(always)]
+pub fn candidate_force_hinted<L: Law>(
+    s: &StepState,
+    law: &L,
+    pair: Pair,
+    history: f64,
+    hint: Hint,
+) -> (Option<(ContactForce, f64)>, Hint) {
+    let (g, input, hint) = if L::AREA {
+        if let Some(r) = polygon_pair(s, law, pair, history, hint) {
+            return r;
         }
-        let c = area_contact(s.particles, s.corners, s.walls, pair);
+        if !crate::contacts::circles_touch(s.particles, s.walls, law.range_factor(), pair) {
+            return (None, Hint::NONE);
+        }
+        let (c, hint) = area_contact_hinted(s.particles, s.corners, s.walls, pair, hint);
         // Polygons touch when their outlines overlap (disks: when their circles do).
         let p = s.particles;
         let polygon =
             p.is_polygon(pair.i as usize) || (!pair.is_wall() && p.is_polygon(pair.j as usize));
         if polygon && c.is_none() {
-            return None;
+            return (None, hint);
         }
-        area_kinematics(s, pair, history, c.unwrap_or_default())
+        let (g, input) = area_kinematics(s, pair, history, c.unwrap_or_default());
+        (g, input, hint)
     } else {
-        let (g, d) = disk_candidate(s, law, pair)?;
-        disk_kinematics(s, pair, history, g, d)
+        let Some((g, d)) = disk_candidate(s, law, pair) else {
+            return (None, Hint::NONE);
+        };
+        let (g, input) = disk_kinematics(s, pair, history, g, d);
+        (g, input, Hint::NONE)
     };
-    Some(contact_force(
-        s.particles,
-        |c| law.evaluate(c),
-        pair,
-        &g,
-        &input,
-    ))
+    let r = contact_force(s.particles, |c| law.evaluate(c), pair, &g, &input);
+    (Some(r), hint)
 }
 
 /// A disk law's first half of `candidate_force`: the geometry of a candidate, None when
@@ -477,7 +494,9 @@ fn candidates_with<L: Law>(
         settle(&watch, list.pairs[k], r, kick, h)
     };
     let evaluate = |k: usize, kick: &mut Kick, h: &mut f64| {
-        let r = candidate_force(s, law, list.pairs[k], list.history[k]);
+        let hint = list.hints.get(k);
+        let (r, hint) = candidate_force_hinted(s, law, list.pairs[k], list.history[k], hint);
+        list.hints.set(k, hint);
         settle(k, r, kick, h)
     };
     if record {
@@ -691,6 +710,42 @@ fn material_velocity(
     ([v[0] + w[0], v[1] + w[1]], s.particles.mass[j])
 }
 
+/// `candidate_force_hinted` for a pair of polygons (None for any other pair): the broad
+/// test, the overlap from the hint and the law, with the pair's offset taken once.
+#[inline(always)]
+fn polygon_pair<L: Law>(
+    s: &StepState,
+    law: &L,
+    pair: Pair,
+    history: f64,
+    hint: Hint,
+) -> Option<(Option<(ContactForce, f64)>, Hint)> {
+    let (p, c) = (s.particles, s.corners);
+    let (i, j) = (pair.i as usize, pair.j as usize);
+    if pair.is_wall() || c.of(i).is_empty() || c.of(j).is_empty() {
+        return None;
+    }
+    let d = offset(p, i, j);
+    // The circumscribed circles within range (`contacts::circles_touch`), squared.
+    let (ri, rj) = (p.radius[i], p.radius[j]);
+    let reach = law.range_factor() * (ri + rj);
+    if !(d[0] * d[0] + d[1] * d[1] < reach * reach) {
+        return Some((None, Hint::NONE));
+    }
+    let (contact, hint) = polygon_polygon_hinted(
+        &c.outline(i, [0.0; 2], ri),
+        &c.outline(j, [-d[0], -d[1]], rj),
+        d,
+        hint,
+    );
+    let Some(contact) = contact else {
+        return Some((None, hint));
+    };
+    let (g, input) = area_kinematics(s, pair, history, contact);
+    let r = contact_force(s.particles, |c| law.evaluate(c), pair, &g, &input);
+    Some((Some(r), hint))
+}
+
 /// The overlap-area geometry of a pair (SPEC 2.3), whatever the shapes, in the frame of
 /// i's centre; None when they do not overlap.
 pub fn area_contact(
@@ -699,27 +754,48 @@ pub fn area_contact(
     walls: &[WallSegment],
     pair: Pair,
 ) -> Option<AreaContact> {
+    area_contact_hinted(particles, corners, walls, pair, Hint::NONE).0
+}
+
+/// [`area_contact`] from the pair's hint (polygon pairs), and its hint for the next step.
+#[inline(always)]
+pub fn area_contact_hinted(
+    particles: &Particles,
+    corners: &RotatedCorners,
+    walls: &[WallSegment],
+    pair: Pair,
+    hint: Hint,
+) -> (Option<AreaContact>, Hint) {
     let i = pair.i as usize;
     let (ri, poly_i) = (particles.radius[i], particles.is_polygon(i));
     if pair.is_wall() {
         let wall = &walls[(pair.j - WALL_BASE) as usize];
         let w = wall_from(wall, particles.position(i));
-        return if poly_i {
+        let c = if poly_i {
             polygon_wall(corners.of(i), &w)
         } else {
             disk_wall_area(ri, &w)
         };
+        return (c, Hint::NONE);
     }
     let j = pair.j as usize;
     let d = offset(particles, i, j);
     let rj = particles.radius[j];
-    match (poly_i, particles.is_polygon(j)) {
-        (true, true) => polygon_polygon(corners.of(i), corners.of(j), d),
+    let c = match (poly_i, particles.is_polygon(j)) {
+        (true, true) => {
+            return polygon_polygon_hinted(
+                &corners.outline(i, [0.0; 2], ri),
+                &corners.outline(j, [-d[0], -d[1]], rj),
+                d,
+                hint,
+            );
+        }
         // The polygon's centre relative to the disk's.
         (true, false) => polygon_disk(corners.of(i), d, rj, true),
         (false, true) => polygon_disk(corners.of(j), [-d[0], -d[1]], ri, false),
         (false, false) => disk_disk_area(d, ri, rj),
-    }
+    };
+    (c, Hint::NONE)
 }
 
 /// What the overlap-area law needs from an area contact's geometry (SPEC 2.3,

@@ -31,8 +31,10 @@
 use crate::cell_list::Grid;
 use crate::contacts::{Pair, WALL_BASE};
 use crate::geometry::{WallSegment, disk_wall, wall_from};
+use crate::overlap::Hint;
 use crate::springs::{SpringTable, pair_key};
 use crate::state::{Dof, Particles};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The default skin, as a fraction of the largest diameter.
 pub const DEFAULT_SKIN: f64 = 0.3;
@@ -53,6 +55,12 @@ pub struct NeighbourList {
     /// Spheropolygon scenes (law hertz_cohesive): each candidate's sub-contact springs,
     /// moved with the slots like `history` (empty under the other laws).
     pub sub_history: Vec<crate::spheropolygon::SubSprings>,
+    /// Each candidate's hint of what its last evaluation found (polygon pairs,
+    /// `overlap::Hint`): it decides only how much work the next evaluation takes, never
+    /// its result, so it is not part of the state (no checkpoint keeps it). Moved with
+    /// the slots like `history`; updated in place by the evaluation, each slot by its
+    /// own candidate.
+    pub hints: Hints,
     /// Positions at the last rebuild, and which particles were active then.
     at: Vec<Dof>,
     active: Vec<bool>,
@@ -162,8 +170,15 @@ impl NeighbourList {
             self.sub_history.clear();
         }
         let history = if self.is_built() {
-            carry_over(&self.pairs, &self.history, &pairs, ids)
+            let origin = origins(&self.pairs, &pairs, ids);
+            self.hints = Hints(
+                (origin.iter())
+                    .map(|o| AtomicU32::new(o.map_or(0, |k| self.hints.get(k).0)))
+                    .collect(),
+            );
+            carry_over(&origin, &self.history)
         } else {
+            self.hints = Hints::none(pairs.len());
             pairs
                 .iter()
                 .map(|&p| table.lookup(pair_key(id_pair(p, ids))).unwrap_or(0.0))
@@ -234,6 +249,11 @@ impl NeighbourList {
         }
         start.push(pairs.len() as u32);
         self.history = gather(&self.history, &from);
+        self.hints = Hints(
+            (from.iter())
+                .map(|&k| AtomicU32::new(self.hints.get(k as usize).0))
+                .collect(),
+        );
         if self.sub_history.len() == self.pairs.len() {
             self.sub_history = gather(&self.sub_history, &from);
         }
@@ -249,6 +269,54 @@ impl NeighbourList {
             self.active.clear();
         }
         from
+    }
+}
+
+/// The candidates' hints (`NeighbourList::hints`): one word each, which the evaluation
+/// of candidate k reads and rewrites through a shared list (no other candidate touches
+/// slot k, so the order of the threads changes nothing).
+#[derive(Debug, Default)]
+pub struct Hints(Vec<AtomicU32>);
+
+impl Hints {
+    fn none(n: usize) -> Self {
+        Self((0..n).map(|_| AtomicU32::new(0)).collect())
+    }
+
+    /// Candidate k's hint (none for a slot the list does not have).
+    #[inline]
+    pub fn get(&self, k: usize) -> Hint {
+        Hint(self.0.get(k).map_or(0, |h| h.load(Ordering::Relaxed)))
+    }
+
+    #[inline]
+    pub fn set(&self, k: usize, h: Hint) {
+        if let Some(slot) = self.0.get(k) {
+            slot.store(h.0, Ordering::Relaxed);
+        }
+    }
+
+    /// Every hint forgotten (the next evaluation starts from none).
+    pub fn forget(&self) {
+        self.0.iter().for_each(|h| h.store(0, Ordering::Relaxed));
+    }
+
+    /// How many candidates have a hint.
+    pub fn known(&self) -> usize {
+        self.0
+            .iter()
+            .filter(|h| h.load(Ordering::Relaxed) != 0)
+            .count()
+    }
+}
+
+impl Clone for Hints {
+    fn clone(&self) -> Self {
+        Self(
+            (self.0.iter())
+                .map(|h| AtomicU32::new(h.load(Ordering::Relaxed)))
+                .collect(),
+        )
     }
 }
 
@@ -397,6 +465,13 @@ fn candidates_of(s: &Search, i: usize, out: &mut Vec<Pair>) {
 /// For each new candidate, the index of the same pair in the old list (None: a new
 /// pair): both lists are in the same memory order and sorted by (slot of i, partner
 /// id), so one merge finds every pair that stays a candidate.
+/// Each new candidate's value from the old list (`origins`); a new pair starts at 0.
+fn carry_over(origin: &[Option<usize>], values: &[f64]) -> Vec<f64> {
+    (origin.iter())
+        .map(|o| o.map_or(0.0, |k| values[k]))
+        .collect()
+}
+
 fn origins(old: &[Pair], new: &[Pair], ids: &[u32]) -> Vec<Option<usize>> {
     let key = |p: &Pair| (p.i, partner_key(*p, ids));
     let mut out = Vec::with_capacity(new.len());
@@ -408,13 +483,6 @@ fn origins(old: &[Pair], new: &[Pair], ids: &[u32]) -> Vec<Option<usize>> {
         out.push((k < old.len() && old[k] == *p).then_some(k));
     }
     out
-}
-
-/// Each new candidate's history from the old list (`origins`); a new pair starts at 0.
-fn carry_over(old: &[Pair], values: &[f64], new: &[Pair], ids: &[u32]) -> Vec<f64> {
-    (origins(old, new, ids).into_iter())
-        .map(|o| o.map_or(0.0, |k| values[k]))
-        .collect()
 }
 
 /// For each slot the candidates in which it is the higher id (j), by increasing partner
@@ -477,7 +545,7 @@ mod tests {
         ];
         let ids = [0, 1, 2, 3, 4];
         assert_eq!(
-            carry_over(&old, &values, &new, &ids),
+            carry_over(&origins(&old, &new, &ids), &values),
             vec![2.0, 0.0, 3.0, 0.0, 4.0]
         );
     }

@@ -77,6 +77,20 @@ where
     });
 }
 
+/// f(k0, share) for each thread's contiguous share v[k0..k0 + share.len()] (all of v on
+/// one thread for a small stage): for loops that walk their items with iterators, with
+/// no call and no bounds check per item.
+pub fn for_each_share<T, F>(v: &mut [T], f: F)
+where
+    T: Send,
+    F: Fn(usize, &mut [T]) + Sync + Send,
+{
+    let parts = threads_for(v.len());
+    let b = bounds(v.len(), parts, 1);
+    let s = shares(v, &b);
+    crate::team::run(parts, &|t| f(b[t], &mut take(&s, t)));
+}
+
 /// f(k, &mut a[k], &mut b[k]) for every k (a and b of equal length).
 pub fn for_each2<A, B, F>(a: &mut [A], b: &mut [B], f: F)
 where

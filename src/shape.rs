@@ -107,7 +107,8 @@ pub fn rotate(v: &[P2], theta: f64, out: &mut Vec<P2>) {
 
 /// Every polygon's corners turned to its current orientation, relative to its centre,
 /// rebuilt each step after the orientations change (disks have none): particle i's are
-/// `corners[start[i]..start[i + 1]]`.
+/// `corners[start[i]..start[i + 1]]`, contiguous, computed once per polygon per step and
+/// read by each of its pairs (issue 37 item 4).
 #[derive(Clone, Debug, Default)]
 pub struct RotatedCorners {
     pub start: Vec<u32>,
@@ -122,6 +123,17 @@ pub struct RotatedCorners {
 impl RotatedCorners {
     pub fn of(&self, i: usize) -> &[P2] {
         &self.corners[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+
+    /// Polygon i's outline in a frame where its centre lies at `base`; `reach`: its
+    /// circumscribed radius.
+    #[inline]
+    pub fn outline(&self, i: usize, base: P2, reach: f64) -> crate::overlap::Outline<'_> {
+        crate::overlap::Outline {
+            v: self.of(i),
+            base,
+            reach,
+        }
     }
 }
 
@@ -154,10 +166,13 @@ pub fn rotate_corners(particles: &crate::state::Particles, out: &mut RotatedCorn
         }
     });
     let (owner, body, turn) = (&out.owner, &out.body, &out.turn);
-    crate::parallel::for_each(&mut out.corners, |k, x| {
-        let [s, c] = turn[owner[k] as usize];
-        let v = body[k];
-        *x = [c * v[0] - s * v[1], s * v[0] + c * v[1]];
+    crate::parallel::for_each_share(&mut out.corners, |k0, share| {
+        let n = share.len();
+        let from = body[k0..k0 + n].iter().zip(&owner[k0..k0 + n]);
+        for (x, (v, &o)) in share.iter_mut().zip(from) {
+            let [s, c] = turn[o as usize];
+            *x = [c * v[0] - s * v[1], s * v[0] + c * v[1]];
+        }
     });
 }
 

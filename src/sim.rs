@@ -99,6 +99,9 @@ pub struct Simulation {
     /// Whether a step lists its contacts in `pairs` and `contacts` (default; a run
     /// turns it off for the steps between its outputs).
     pub record_contacts: bool,
+    /// Whether polygon pairs start from their hint of the last step (default): off, every
+    /// evaluation starts from none, for the tests that the hints change nothing.
+    pub use_hints: bool,
     /// Every particle's velocity q1/dt at the evaluated state.
     velocity: Vec<Dof>,
     /// The first active particle whose position at the evaluated state is not finite.
@@ -206,6 +209,7 @@ impl Simulation {
             step,
             lost,
             corners: RotatedCorners::default(),
+            use_hints: true,
             pairs: Vec::new(),
             contacts: Vec::new(),
             forces: Vec::new(),
@@ -388,6 +392,9 @@ impl Simulation {
             }
         }
         rotate_corners(&self.particles, &mut self.corners);
+        if !self.use_hints {
+            self.neighbours.hints.forget();
+        }
         let state = StepState {
             particles: &self.particles,
             velocity: &self.velocity,

@@ -230,9 +230,9 @@ pub struct SubContact {
     pub arm: P2,
 }
 
-/// The sub-contacts of a pair, inline up to eight (a rod pair has at most four): no heap
+/// The sub-contacts of a pair, inline up to four (what a rod pair has at most; a pair of cores with more corners may spill): no heap
 /// allocation per pair and step.
-pub type SubList = smallvec::SmallVec<[SubContact; 8]>;
+pub type SubList = smallvec::SmallVec<[SubContact; 4]>;
 
 pub const VERTEX_I: u32 = 0;
 pub const VERTEX_J: u32 = 1 << 16;
@@ -404,7 +404,7 @@ pub struct PairForce {
     /// The updated springs of the sub-contacts in range.
     pub springs: SubSprings,
     /// Each sub-contact in range with its law's output (forces along n and t).
-    pub contacts: smallvec::SmallVec<[(SubContact, crate::law::ContactOutput); 8]>,
+    pub contacts: smallvec::SmallVec<[(SubContact, crate::law::ContactOutput); 4]>,
 }
 
 /// The motion of one body: velocity (x, z) and angular velocity.
@@ -416,6 +416,7 @@ pub type Motion = [f64; 3];
 /// paper 004's law, each sub-contact with its own spring from `springs` (SPEC 2.4). A
 /// wall is a spheropolygon of sweep radius 0 that does not move.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub fn pair_force(
     law: &crate::law::hertz_cohesive::HertzCohesive,
     p: (&[P2], f64),
@@ -431,7 +432,7 @@ pub fn pair_force(
     // The deepest first: they keep their springs when there are more than MAX_SUB.
     subs.sort_by(|a, b| b.delta.total_cmp(&a.delta).then(a.key.cmp(&b.key)));
     let mut out = PairForce::default();
-    for (k, c) in subs.into_iter().enumerate() {
+    for (k, &c) in subs.iter().enumerate() {
         // The contact point relative to each centre, and the velocity of each surface there.
         let (li, lj) = (c.arm, [c.arm[0] + d[0], c.arm[1] + d[1]]);
         let ui = [vi[0] - vi[2] * li[1], vi[1] + vi[2] * li[0]];

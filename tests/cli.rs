@@ -984,7 +984,9 @@ fn bench_measures_a_software_adapter_only_when_asked() {
 }
 
 /// `talus check --estimate` says the run's expected work (the model of
-/// `run::expected_work`, tests/progress.rs) and a time for it on the CPU path.
+/// `run::expected_work`, tests/progress.rs) and a time for it on the CPU path: for a
+/// pour, from the rates of stand-ins for its grown heap at several sizes (issue 37 item
+/// 7); for a scene that only settles, from the scene itself.
 #[test]
 fn check_estimates_the_run_time() {
     let set = ["--set", "stop.time=20", "--set", "particles[1].count=100"];
@@ -1008,10 +1010,37 @@ fn check_estimates_the_run_time() {
     );
     let line = out
         .lines()
-        .find(|l| l.starts_with("cpu:"))
+        .find(|l| l.starts_with("cpu:") && l.contains("for the whole run"))
         .expect("a line for the CPU path");
     assert!(
         line.contains("particle-steps/s") && line.contains("for the whole run"),
+        "{line}"
+    );
+    // The pour of 100 grains is timed on its grown heap: stand-ins of 200 particles (the
+    // least) and no more, since 100 is below it.
+    let grown: Vec<&str> = out
+        .lines()
+        .filter(|l| l.contains("the heap grown to"))
+        .collect();
+    assert_eq!(grown.len(), 1, "{out}");
+    assert!(grown[0].starts_with("cpu: the heap grown to 200"), "{out}");
+    assert!(line.contains("as the heap grows"), "{line}");
+    // A pile that only settles is timed as it stands.
+    let (code, out, err) = talus(&[
+        "check",
+        "scenes/r1_pile_reduced.json",
+        "--estimate",
+        "--backend",
+        "cpu",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert!(!out.contains("the heap grown"), "{out}");
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("cpu:"))
+        .expect("a CPU line");
+    assert!(
+        line.contains("over steps") && line.contains("for the whole run"),
         "{line}"
     );
 }

@@ -144,7 +144,12 @@ fn overlap_geometry_of_random_convex_pairs() {
         // Swapping i and j: same area, point and arm; opposite normal.
         let (h, h_point) = polygon_polygon_world(&q, cj, &p, ci).unwrap();
         assert!((h.area - g.area).abs() < 1e-12);
-        assert!((h.l - g.l).abs() < 1e-12);
+        assert!(
+            (h.l - g.l).abs() < 1e-12,
+            "l {} vs {}: {g:?} vs {h:?}\n p {p:?} ci {ci:?}\n q {q:?} cj {cj:?}",
+            g.l,
+            h.l
+        );
         if g.chord > 1e-6 {
             assert!((h_point[0] - point[0]).abs() < 1e-12 && (h_point[1] - point[1]).abs() < 1e-12);
             assert!((h.n[0] + g.n[0]).abs() < 1e-9 && (h.n[1] + g.n[1]).abs() < 1e-9);

@@ -114,6 +114,41 @@ fn results_do_not_depend_on_the_skin() {
 }
 
 #[test]
+fn results_do_not_depend_on_the_polygon_hints() {
+    // Each polygon candidate keeps a hint of what its last step found (apart by an edge,
+    // or resting along a chain of corners: src/overlap/hint.rs) that only saves work.
+    // With hints and with every evaluation starting from none, the heptagon pour (grains
+    // landing, sliding, turning) and the lattice pile of 12-gons (faces pressed and faces
+    // touching to rounding) give bitwise the same runs; and the hints are used.
+    let pile =
+        common::parse(&serde_json::from_str(&talus::bench::polygon_pile_scene(300)).unwrap());
+    let scenes = [
+        ("heptagon pour", pour(true, None), 4000),
+        ("lattice pile", serde_json::to_value(pile).unwrap(), 400),
+    ];
+    for (name, v, steps) in scenes {
+        let with = run(&v, steps);
+        let mut cold = common::sim(&v);
+        cold.use_hints = false;
+        for _ in 0..steps {
+            cold.step().unwrap();
+        }
+        assert_same(&with, &cold, &format!("{name}, hints against none"));
+        let (known, pairs) = (with.neighbours.hints.known(), with.neighbours.pairs.len());
+        eprintln!("{name}: {known} of {pairs} candidates with a hint");
+        assert!(
+            known > pairs / 3,
+            "{name}: {known} of {pairs} candidates with a hint"
+        );
+        assert!(
+            with.pairs.len() > 50,
+            "{name}: {} contacts",
+            with.pairs.len()
+        );
+    }
+}
+
+#[test]
 fn results_do_not_depend_on_the_thread_count() {
     // Every stage split over the threads even for these small scenes.
     talus::parallel::set_min_parallel(1);

@@ -5,6 +5,7 @@
 //! run.
 
 mod engine;
+pub mod estimate;
 pub mod folder;
 pub mod outputs;
 

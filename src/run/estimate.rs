@@ -1,0 +1,219 @@
+//! How long a run will take (`talus check --estimate`, issue 37 item 7), timed where its
+//! cost is.
+//!
+//! A particle-step costs what its particle's neighbourhood costs: a grain falling from
+//! a point source has no neighbours, one in the grown heap has six candidates and four
+//! contacts. Timing a pour from its start (what the estimate did before) measures the
+//! falling grains and was 6–7× low for the 50 000-polygon heap. So a pour is timed on
+//! stand-ins for its grown heap (`grown_pile`): a settled lattice pile of the source's
+//! own particles (the same shape family, the mean size, the scene's law, time step and
+//! gravity) at several sizes up to the final count. The rate between the sizes is
+//! interpolated in log–log, and the run's expected work (`run::expected_work`: the
+//! moving particles of each step, insertions at their rates) is divided by the rate at
+//! its size, step range by step range. A scene without sources is timed as it stands.
+
+use crate::progress::Work;
+use crate::scene::{Creation, Scene, SceneError, Size};
+
+/// The particle count of the largest stand-in pile (a bigger heap runs at this one's
+/// rate: beyond a few 10⁴ particles the rate per particle hardly changes).
+pub const LARGEST_PILE: usize = 60_000;
+
+/// A measured rate: moving particles and particle-steps per second.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rate {
+    pub particles: f64,
+    pub per_second: f64,
+}
+
+/// The mean of a size.
+fn mean(s: &Size) -> f64 {
+    let (lo, hi) = s.bounds();
+    0.5 * (lo + hi)
+}
+
+/// A stand-in for `scene`'s first point source grown to about `n` particles: a 60°
+/// triangular pile of its particles (disks of its mean diameter, or regular polygons of
+/// its corner count and mean axis, each at a random orientation) on a fixed bottom
+/// row, centred under the outlet, on the scene's highest wall below it (or at the
+/// domain's floor), in a domain grown to hold it; no sources. Polygons sit 3 % closer
+/// than their circumscribed circles, so that neighbours touch as in a heap (some
+/// corners into faces: the pile starts a little compressed, `limits.initial_overlap`
+/// is lifted for it). None when the scene has no point source, or pours rods (their
+/// deposits are not such piles).
+pub fn grown_pile(scene: &Scene, n: usize) -> Result<Option<Scene>, SceneError> {
+    let Some(source) = scene.particles.iter().find_map(|c| match c {
+        Creation::PointSource(s) => Some(s),
+        _ => None,
+    }) else {
+        return Ok(None);
+    };
+    if source.rod.is_some() {
+        return Ok(None);
+    }
+    let (across, spacing, polygon) = match (&source.polygon, &source.diameter) {
+        (Some(p), _) => {
+            let across = match &p.axes {
+                Some([a, b]) => 0.5 * (mean(a) + mean(b)),
+                None => source.diameter.as_ref().map_or(1.0, mean),
+            };
+            (
+                across,
+                0.97 * across,
+                Some(serde_json::json!({ "corners": p.corners })),
+            )
+        }
+        (None, Some(d)) => (mean(d), mean(d), None),
+        (None, None) => return Ok(None),
+    };
+    // Row M of a 60° pile holds L − M particles: L (L + 1)/2 in all.
+    let l = (((8 * n.max(3) + 1) as f64).sqrt() - 1.0) / 2.0;
+    let l = (l.round() as usize).max(2);
+    let half_width = 0.5 * l as f64 * spacing + 2.0 * across;
+    let x0 = source.position[0];
+    // On the highest wall under the pile's footprint, else the domain's floor.
+    let under = |w: &crate::scene::Wall| {
+        let (lo, hi) = (w.from[0].min(w.to[0]), w.from[0].max(w.to[0]));
+        lo <= x0 + half_width && hi >= x0 - half_width
+    };
+    let base = (scene.walls.iter())
+        .filter(|w| under(w))
+        .map(|w| w.from[1].max(w.to[1]))
+        .filter(|&z| z < source.position[1])
+        .fold(f64::NEG_INFINITY, f64::max);
+    let base = if base.is_finite() {
+        base
+    } else {
+        scene.domain.z[0] + across
+    };
+    let mut rng = crate::rng::Rng::new(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
+    let rise = spacing * 3f64.sqrt() / 2.0;
+    let mut list = Vec::with_capacity(l * (l + 1) / 2);
+    for m in 0..l {
+        let count = l - m;
+        for k in 0..count {
+            let x = x0 + (k as f64 - 0.5 * (count - 1) as f64) * spacing;
+            let theta = if polygon.is_some() {
+                rng.range(0.0, std::f64::consts::TAU)
+            } else {
+                0.0
+            };
+            list.push(serde_json::json!({
+                "position": [x, base + 0.5 * across + m as f64 * rise],
+                "diameter": across, "theta": theta, "fixed": m == 0,
+            }));
+        }
+    }
+    let height = l as f64 * rise + 2.0 * across;
+    let mut v = serde_json::to_value(scene).expect("a scene serialises");
+    let mut pile = serde_json::json!({
+        "kind": "list", "material": source.material, "particles": list,
+    });
+    if let Some(p) = polygon {
+        pile["polygon"] = p;
+    }
+    v["particles"] = serde_json::json!([pile]);
+    let d = &scene.domain;
+    v["domain"]["x"] =
+        serde_json::json!([d.x[0].min(x0 - half_width), d.x[1].max(x0 + half_width)]);
+    v["domain"]["z"] = serde_json::json!([d.z[0].min(base - across), d.z[1].max(base + height)]);
+    v["limits"]["initial_overlap"] = serde_json::json!(1.0);
+    v["name"] = serde_json::json!(format!("{}-grown-{n}", scene.name));
+    crate::scene::parse(&v.to_string(), &[]).map(Some)
+}
+
+/// The sizes a pour's stand-ins are timed at: the final count and two smaller ones (a
+/// factor 4 apart), each at least 200 and at most [`LARGEST_PILE`].
+pub fn pile_sizes(final_count: f64) -> Vec<usize> {
+    let top = (final_count as usize).clamp(200, LARGEST_PILE);
+    let mut sizes: Vec<usize> = [top / 16, top / 4, top]
+        .into_iter()
+        .map(|n| n.max(200))
+        .collect();
+    sizes.dedup();
+    sizes
+}
+
+/// The rate at `particles` from the measured ones: log–log between the two sizes about
+/// it, the nearest one's beyond them.
+pub fn rate_at(rates: &[Rate], particles: f64) -> f64 {
+    let mut r: Vec<Rate> = rates.to_vec();
+    r.sort_by(|a, b| a.particles.total_cmp(&b.particles));
+    let (first, last) = (r[0], r[r.len() - 1]);
+    if particles <= first.particles {
+        return first.per_second;
+    }
+    if particles >= last.particles {
+        return last.per_second;
+    }
+    let k = r.partition_point(|x| x.particles <= particles);
+    let (a, b) = (r[k - 1], r[k]);
+    let f = (particles.ln() - a.particles.ln()) / (b.particles.ln() - a.particles.ln());
+    (a.per_second.ln() + f * (b.per_second.ln() - a.per_second.ln())).exp()
+}
+
+/// Seconds the run takes: each range of steps between the work's samples at the rate of
+/// its size (its mean moving count, the work over the steps).
+pub fn run_time(work: &Work, rates: &[Rate]) -> f64 {
+    work.samples
+        .windows(2)
+        .map(|w| {
+            let (steps, done) = ((w[1].0 - w[0].0) as f64, w[1].1 - w[0].1);
+            if steps <= 0.0 || done <= 0.0 {
+                return 0.0;
+            }
+            done / rate_at(rates, done / steps)
+        })
+        .sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_rate_between_sizes_is_log_log() {
+        let r = [
+            Rate {
+                particles: 100.0,
+                per_second: 1e6,
+            },
+            Rate {
+                particles: 10_000.0,
+                per_second: 4e6,
+            },
+        ];
+        assert_eq!(rate_at(&r, 50.0), 1e6);
+        assert_eq!(rate_at(&r, 1e5), 4e6);
+        // Halfway in log N: the geometric mean of the rates.
+        assert!((rate_at(&r, 1000.0) - 2e6).abs() < 1e-6);
+        // A pour growing linearly from 0 to 10⁴ over 10⁴ steps, timed at both ends.
+        let samples = (0..=100u64)
+            .map(|k| (k * 100, 0.5 * (k * 100) as f64 * (k * 100) as f64))
+            .collect();
+        let t = run_time(&Work { samples }, &r);
+        let slow = run_time(
+            &Work {
+                samples: vec![(0, 0.0), (10_000, 5e7)],
+            },
+            &r,
+        );
+        // Between the whole run at the small heap's rate and at the big one's.
+        assert!(t < 5e7 / 1e6 && t > 5e7 / 4e6 && slow > 0.0, "{t}");
+    }
+
+    #[test]
+    fn the_grown_pile_holds_about_the_count_of_the_source() {
+        let s = crate::scene::parse(crate::scene::DEFAULT_SCENE, &[]).unwrap();
+        let g = grown_pile(&s, 1000)
+            .unwrap()
+            .expect("the default heap pours");
+        let sim = crate::sim::Simulation::new(g).unwrap();
+        let n = sim.particles.len();
+        assert!((900..1100).contains(&n), "{n} particles");
+        assert!(sim.particles.mobile_count() < n, "a fixed bottom row");
+        assert!(sim.sources.is_empty());
+        assert_eq!(pile_sizes(50_000.0), vec![3125, 12_500, 50_000]);
+        assert_eq!(pile_sizes(333.0), vec![200, 333]);
+    }
+}
