@@ -896,14 +896,62 @@ fn estimate_run_time(sim: Simulation, backend: Backend) -> Result<(), Failure> {
     let final_count = (0..=10)
         .map(|k| run::expected_moving(&sim, sim.dt() * (total * k / 10) as f64))
         .fold(0.0, f64::max);
-    let piles: Vec<(usize, Simulation)> = if final_count > 2.0 * sim.particles.mobile_count() as f64
-    {
+    let pour = final_count > 2.0 * sim.particles.mobile_count() as f64;
+    let mut work = work;
+    let mut start = None;
+    if pour {
+        // The pour's first seconds, for the pace of its sources: one that waits for its
+        // spot at the outlet places fewer particles than its rate says, and the run
+        // then does less work (and builds a smaller heap by its end).
+        let (rate, _, _, _, now) = time_engine_keep(&sim, Backend::Cpu, 3.0, None, false)?;
+        // Its rate then stands for the heap while it is small (a few falling grains
+        // and the first of the heap: the per-step costs weigh most there), at the mean
+        // of its moving particles then.
+        if let Some(r) = rate {
+            start = Some(Rate {
+                particles: 0.5
+                    * (sim.particles.mobile_count() + now.particles.mobile_count()) as f64,
+                per_second: r,
+            });
+        }
+        let pace = estimate::source_pace(&now);
+        if pace.iter().any(|&p| p < 0.9) {
+            for (k, p) in pace.iter().enumerate().filter(|(_, p)| **p < 0.9) {
+                out!(
+                    "point source {k} places {:.0} % of its rate in its first {:.3} time units: a spot at its outlet is free only once the grain before has fallen clear of it (a faster drop, a wider spread or a lower rate keeps up)",
+                    100.0 * p,
+                    now.time()
+                );
+            }
+            let slowed = Simulation::new(estimate::at_pace(&sim.scene, &pace))?;
+            work = run::expected_work(&slowed, total);
+            out!(
+                "expected work at that pace: {:.3e} particle-steps (and {:.0} particles by the end)",
+                work.total(),
+                (0..=10)
+                    .map(|k| run::expected_moving(&slowed, sim.dt() * (total * k / 10) as f64))
+                    .fold(0.0, f64::max)
+            );
+        }
+    }
+    let final_count = if pour {
+        (0..=10)
+            .map(|k| {
+                let at = (total * k / 10).max(1);
+                (work.at(at) - work.at(at - 1)).max(0.0)
+            })
+            .fold(0.0, f64::max)
+            .max(1.0)
+    } else {
+        final_count
+    };
+    let piles: Vec<(usize, Simulation)> = if pour {
         let mut piles = Vec::new();
         for n in estimate::pile_sizes(final_count) {
-            let Some(scene) = estimate::grown_pile(&sim.scene, n)? else {
+            let Some(pile) = estimate::grown_pile(&sim.scene, n)? else {
                 break;
             };
-            piles.push((n, Simulation::new(scene)?));
+            piles.push((n, pile));
         }
         piles
     } else {
@@ -911,7 +959,7 @@ fn estimate_run_time(sim: Simulation, backend: Backend) -> Result<(), Failure> {
     };
     for b in backends {
         if piles.is_empty() {
-            let (rate, from, to, name) = time_engine(&sim, b, 3.0, Some(&work))?;
+            let (rate, from, to, (name, _)) = time_engine(&sim, b, 3.0, Some(&work))?;
             let Some(rate) = rate else {
                 out!("{name}: no moving particles in the timed steps; no estimate");
                 continue;
@@ -923,14 +971,28 @@ fn estimate_run_time(sim: Simulation, backend: Backend) -> Result<(), Failure> {
             continue;
         }
         let (mut rates, mut name) = (Vec::new(), String::new());
+        // The pour's own start, timed on the CPU path above.
+        if b == Backend::Cpu {
+            if let Some(r) = start.filter(|r| r.particles >= 1.0) {
+                out!(
+                    "{}: the pour's start ({:.0} moving on average): {:.3e} particle-steps/s",
+                    "cpu",
+                    r.particles,
+                    r.per_second
+                );
+                rates.push(r);
+            }
+        }
         for (n, pile) in &piles {
             let (rate, _, to, engine) = time_engine(pile, b, 2.0, None)?;
-            name = engine;
+            let contacts;
+            (name, contacts) = engine;
             if let Some(r) = rate {
                 let moving = pile.particles.mobile_count() as f64;
                 out!(
-                    "{name}: the heap grown to {n} (a lattice pile of {} moving, at rest): {r:.3e} particle-steps/s over {to} steps",
-                    moving as usize
+                    "{name}: the heap grown to {n} (a lattice pile of {} moving, {:.1} contacts each at the end): {r:.3e} particle-steps/s over {to} steps",
+                    moving as usize,
+                    2.0 * contacts as f64 / pile.particles.len() as f64
                 );
                 rates.push(Rate {
                     particles: moving,
@@ -954,16 +1016,19 @@ fn estimate_run_time(sim: Simulation, backend: Backend) -> Result<(), Failure> {
 }
 
 /// `sim` on backend b for about `seconds` after a warm-up of 10 steps, in doubling
-/// batches: its rate (particle-steps/s; None if nothing moved), the steps timed and the
-/// engine's name. With
+/// batches: its rate (particle-steps/s; None if nothing moved), the steps timed, and the
+/// engine's name and its contacts at the end. With
 /// `work`, the run's expected work over those steps, up to its stop time; without (a
-/// stand-in pile), its moving particles times the steps, whatever its stop time.
-fn time_engine(
+/// stand-in pile or a pour's start), the mean of its moving particles at the start and
+/// the end times the steps, whatever its stop time. `settle`: first until its particles
+/// touch three others on average (a stand-in pile), for at most 4000 steps and 30 s.
+fn time_engine_keep(
     sim: &Simulation,
     b: Backend,
     seconds: f64,
     work: Option<&talus::progress::Work>,
-) -> Result<(Option<f64>, u64, u64, String), Failure> {
+    settle: bool,
+) -> Result<(Option<f64>, u64, u64, (String, usize), Simulation), Failure> {
     let total = run::total_steps(sim).max(1);
     let start = checkpoint::Checkpoint::fresh(sim.clone());
     let mut engine = match b {
@@ -972,7 +1037,28 @@ fn time_engine(
     };
     let diverged = |e| Failure::failed(format!("the scene diverged while timed: {e}"));
     engine.advance(10.min(total)).map_err(diverged)?;
+    if settle {
+        // A stand-in pile first settles into contact (a lattice of irregular shapes
+        // starts with gaps between many neighbours): until its particles touch three
+        // others on average, for at most 4000 steps and 30 s.
+        let t = std::time::Instant::now();
+        let (mut batch, mut steps) = (64, 0);
+        while steps < 4000 && t.elapsed().as_secs_f64() < 30.0 {
+            engine.advance(batch).map_err(diverged)?;
+            steps += batch;
+            let now = (engine.sim())
+                .map_err(|e| Failure::failed(format!("the device was lost while timed: {e}")))?;
+            if 2 * now.pairs.len() >= 3 * now.particles.len() {
+                break;
+            }
+            batch *= 2;
+        }
+    }
     let (from, t) = (engine.step(), std::time::Instant::now());
+    let moving_from = (engine.sim())
+        .map_err(|e| Failure::failed(format!("the device was lost while timed: {e}")))?
+        .particles
+        .mobile_count() as f64;
     let mut batch = 8;
     let limit = if work.is_some() { total } else { u64::MAX };
     while t.elapsed().as_secs_f64() < seconds && engine.step() < limit {
@@ -981,10 +1067,11 @@ fn time_engine(
         batch *= 2;
     }
     // The GPU runs ahead of the host: a readback waits for it.
-    let moving = (engine.sim())
-        .map_err(|e| Failure::failed(format!("the device was lost while timed: {e}")))?
-        .particles
-        .mobile_count() as f64;
+    let now = (engine.sim())
+        .map_err(|e| Failure::failed(format!("the device was lost while timed: {e}")))?;
+    let (moving, contacts) = (now.particles.mobile_count() as f64, now.pairs.len());
+    let now = now.clone();
+    let moving = 0.5 * (moving + moving_from);
     let seconds = t.elapsed().as_secs_f64();
     let to = engine.step();
     let done = match work {
@@ -995,8 +1082,20 @@ fn time_engine(
         (done > 0.0).then(|| done / seconds),
         from,
         to,
-        engine.name(),
+        (engine.name(), contacts),
+        now,
     ))
+}
+
+/// `time_engine_keep` without the state it reached.
+fn time_engine(
+    sim: &Simulation,
+    b: Backend,
+    seconds: f64,
+    work: Option<&talus::progress::Work>,
+) -> Result<(Option<f64>, u64, u64, (String, usize)), Failure> {
+    let (rate, from, to, named, _) = time_engine_keep(sim, b, seconds, work, work.is_none())?;
+    Ok((rate, from, to, named))
 }
 
 /// A duration in words: seconds, minutes, hours or days.

@@ -13,7 +13,8 @@
 //! its size, step range by step range. A scene without sources is timed as it stands.
 
 use crate::progress::Work;
-use crate::scene::{Creation, Scene, SceneError, Size};
+use crate::scene::{Creation, Scene, SceneError};
+use crate::sim::Simulation;
 
 /// The particle count of the largest stand-in pile (a bigger heap runs at this one's
 /// rate: beyond a few 10⁴ particles the rate per particle hardly changes).
@@ -26,49 +27,53 @@ pub struct Rate {
     pub per_second: f64,
 }
 
-/// The mean of a size.
-fn mean(s: &Size) -> f64 {
-    let (lo, hi) = s.bounds();
-    0.5 * (lo + hi)
-}
-
-/// A stand-in for `scene`'s first point source grown to about `n` particles: a 60°
-/// triangular pile of its particles (disks of its mean diameter, or regular polygons of
-/// its corner count and mean axis, each at a random orientation) on a fixed bottom
-/// row, centred under the outlet, on the scene's highest wall below it (or at the
-/// domain's floor), in a domain grown to hold it; no sources. Polygons sit 3 % closer
-/// than their circumscribed circles, so that neighbours touch as in a heap (some
-/// corners into faces: the pile starts a little compressed, `limits.initial_overlap`
-/// is lifted for it). None when the scene has no point source, or pours rods (their
-/// deposits are not such piles).
-pub fn grown_pile(scene: &Scene, n: usize) -> Result<Option<Scene>, SceneError> {
-    let Some(source) = scene.particles.iter().find_map(|c| match c {
-        Creation::PointSource(s) => Some(s),
-        _ => None,
-    }) else {
+/// A stand-in for `scene`'s first point source grown to about `n` particles: a 30°
+/// triangular pile of the source's own particles (the next n it would draw: their
+/// shapes, sizes and orientations), centred under the outlet, on the scene's highest
+/// wall below it (or on a fixed bottom row at the domain's floor), in a domain grown to
+/// hold it, with the scene's point sources still pouring onto it: the falling stream
+/// costs what it costs in the run (its fast grains rebuild the neighbour lists every few
+/// steps, its impacts keep the top moving). The scene's other particles are left out.
+/// The sites are 3 % closer than the particles' mean circumscribed diameter, so that
+/// neighbours touch as in a heap (some corners into faces: the pile starts a little
+/// compressed, `limits.initial_overlap` is lifted for it). None when the scene has no
+/// point source, or pours rods (their deposits are not such piles).
+pub fn grown_pile(scene: &Scene, n: usize) -> Result<Option<Simulation>, SceneError> {
+    use crate::create::source::{SourceState, particle_at, upcoming};
+    let Some((index, source)) = (scene.particles.iter())
+        .filter_map(|c| match c {
+            Creation::PointSource(s) => Some(s),
+            _ => None,
+        })
+        .enumerate()
+        .next()
+    else {
         return Ok(None);
     };
     if source.rod.is_some() {
         return Ok(None);
     }
-    let (across, spacing, polygon) = match (&source.polygon, &source.diameter) {
-        (Some(p), _) => {
-            let across = match &p.axes {
-                Some([a, b]) => 0.5 * (mean(a) + mean(b)),
-                None => source.diameter.as_ref().map_or(1.0, mean),
-            };
-            (
-                across,
-                0.97 * across,
-                Some(serde_json::json!({ "corners": p.corners })),
-            )
-        }
-        (None, Some(d)) => (mean(d), mean(d), None),
-        (None, None) => return Ok(None),
+    // The particles the source would pour, n of them (its own draws, again from the
+    // start when it pours fewer).
+    let mut spec = source.clone();
+    spec.count = n.max(1) as u32;
+    let drawn = upcoming(&spec, &SourceState::new(scene.seed, index));
+    let material = scene
+        .materials
+        .keys()
+        .position(|m| *m == source.material)
+        .unwrap_or(0) as u32;
+    let mut particles: Vec<crate::state::NewParticle> = (drawn.iter())
+        .map(|d| particle_at(source.polygon.as_ref(), d, [0.0; 2], [0.0; 2], material))
+        .collect();
+    let across = 2.0 * particles.iter().map(|p| p.radius).sum::<f64>() / particles.len() as f64;
+    let spacing = if source.polygon.is_some() {
+        0.97 * across
+    } else {
+        across
     };
-    // Row M of a 60° pile holds L − M particles: L (L + 1)/2 in all.
-    let l = (((8 * n.max(3) + 1) as f64).sqrt() - 1.0) / 2.0;
-    let l = (l.round() as usize).max(2);
+    // Row M of a 30° pile holds L − 3M particles: about L²/6 in all.
+    let l = (((6 * n.max(3)) as f64).sqrt().round() as usize).max(4);
     let half_width = 0.5 * l as f64 * spacing + 2.0 * across;
     let x0 = source.position[0];
     // On the highest wall under the pile's footprint, else the domain's floor.
@@ -81,45 +86,81 @@ pub fn grown_pile(scene: &Scene, n: usize) -> Result<Option<Scene>, SceneError> 
         .map(|w| w.from[1].max(w.to[1]))
         .filter(|&z| z < source.position[1])
         .fold(f64::NEG_INFINITY, f64::max);
-    let base = if base.is_finite() {
+    // On a wall the bottom row rests on it, as a heap's does; else it is fixed.
+    let on_wall = base.is_finite();
+    let base = if on_wall {
         base
     } else {
         scene.domain.z[0] + across
     };
-    let mut rng = crate::rng::Rng::new(scene.seed ^ 0x9E37_79B9_7F4A_7C15);
     let rise = spacing * 3f64.sqrt() / 2.0;
-    let mut list = Vec::with_capacity(l * (l + 1) / 2);
-    for m in 0..l {
-        let count = l - m;
+    let mut sites = Vec::new();
+    for m in 0..l.div_ceil(3) {
+        let count = l - 3 * m;
         for k in 0..count {
             let x = x0 + (k as f64 - 0.5 * (count - 1) as f64) * spacing;
-            let theta = if polygon.is_some() {
-                rng.range(0.0, std::f64::consts::TAU)
-            } else {
-                0.0
-            };
-            list.push(serde_json::json!({
-                "position": [x, base + 0.5 * across + m as f64 * rise],
-                "diameter": across, "theta": theta, "fixed": m == 0,
-            }));
+            sites.push((
+                [x, base + 0.5 * across + m as f64 * rise],
+                m == 0 && !on_wall,
+            ));
         }
     }
-    let height = l as f64 * rise + 2.0 * across;
+    let height = l.div_ceil(3) as f64 * rise + 2.0 * across;
     let mut v = serde_json::to_value(scene).expect("a scene serialises");
-    let mut pile = serde_json::json!({
-        "kind": "list", "material": source.material, "particles": list,
-    });
-    if let Some(p) = polygon {
-        pile["polygon"] = p;
-    }
-    v["particles"] = serde_json::json!([pile]);
+    let sources: Vec<serde_json::Value> = (scene.particles.iter())
+        .filter(|c| matches!(c, Creation::PointSource(_)))
+        .map(|c| serde_json::to_value(c).expect("a creation serialises"))
+        .collect();
+    v["particles"] = serde_json::Value::Array(sources);
     let d = &scene.domain;
     v["domain"]["x"] =
         serde_json::json!([d.x[0].min(x0 - half_width), d.x[1].max(x0 + half_width)]);
     v["domain"]["z"] = serde_json::json!([d.z[0].min(base - across), d.z[1].max(base + height)]);
     v["limits"]["initial_overlap"] = serde_json::json!(1.0);
     v["name"] = serde_json::json!(format!("{}-grown-{n}", scene.name));
-    crate::scene::parse(&v.to_string(), &[]).map(Some)
+    let stand_in = crate::scene::parse(&v.to_string(), &[])?;
+    let mut sim = Simulation::new(stand_in)?;
+    let kinds = particles.len();
+    for (k, (at, fixed)) in sites.into_iter().enumerate() {
+        let p = &mut particles[k % kinds];
+        p.position = at;
+        p.fixed = fixed;
+        crate::create::push(&sim.scene, &mut sim.particles, p);
+    }
+    Ok(Some(sim))
+}
+
+/// How fast each point source of copy 0 really placed its particles in a run now at
+/// `now`: placed over due by then (1 when it kept up, or had not started), in scene
+/// order. A source waits while its spot at the outlet is taken (a grain dropped slowly
+/// has not fallen clear of it when the next falls due), so its pace can be well below
+/// its rate: the 50 000-polygon heap's outlet places about a third of its 200 a second.
+pub fn source_pace(now: &Simulation) -> Vec<f64> {
+    let (sources, _) = crate::sim::creators(&now.scene);
+    let t = now.time();
+    (sources.iter().zip(&now.sources))
+        .map(|(spec, state)| {
+            if t < spec.start_time + 1.0 / spec.rate || state.done(spec) {
+                return 1.0;
+            }
+            let due = (((t - spec.start_time) * spec.rate).floor() + 1.0).min(spec.count as f64);
+            (state.inserted as f64 / due).min(1.0)
+        })
+        .collect()
+}
+
+/// `scene` with each point source's rate times its pace (`source_pace`), in scene
+/// order: what its expected work should assume.
+pub fn at_pace(scene: &Scene, pace: &[f64]) -> Scene {
+    let mut s = scene.clone();
+    let mut k = 0;
+    for c in &mut s.particles {
+        if let Creation::PointSource(p) = c {
+            p.rate *= pace.get(k).copied().unwrap_or(1.0);
+            k += 1;
+        }
+    }
+    s
 }
 
 /// The sizes a pour's stand-ins are timed at: the final count and two smaller ones (a
@@ -205,14 +246,16 @@ mod tests {
     #[test]
     fn the_grown_pile_holds_about_the_count_of_the_source() {
         let s = crate::scene::parse(crate::scene::DEFAULT_SCENE, &[]).unwrap();
-        let g = grown_pile(&s, 1000)
+        let sim = grown_pile(&s, 1000)
             .unwrap()
             .expect("the default heap pours");
-        let sim = crate::sim::Simulation::new(g).unwrap();
         let n = sim.particles.len();
         assert!((900..1100).contains(&n), "{n} particles");
-        assert!(sim.particles.mobile_count() < n, "a fixed bottom row");
-        assert!(sim.sources.is_empty());
+        assert!(
+            sim.particles.mobile_count() < n,
+            "a fixed bottom row (no wall under it)"
+        );
+        assert_eq!(sim.sources.len(), 1, "the source still pours");
         assert_eq!(pile_sizes(50_000.0), vec![3125, 12_500, 50_000]);
         assert_eq!(pile_sizes(333.0), vec![200, 333]);
     }
