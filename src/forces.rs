@@ -163,21 +163,11 @@ pub fn candidate_force_hinted<L: Law>(
     hint: Hint,
 ) -> (Option<(ContactForce, f64)>, Hint) {
     let (g, input, hint) = if L::AREA {
-        if let Some(r) = polygon_pair(s, law, pair, history, hint) {
-            return r;
-        }
-        if !crate::contacts::circles_touch(s.particles, s.walls, law.range_factor(), pair) {
-            return (None, Hint::NONE);
-        }
-        let (c, hint) = area_contact_hinted(s.particles, s.corners, s.walls, pair, hint);
-        // Polygons touch when their outlines overlap (disks: when their circles do).
-        let p = s.particles;
-        let polygon =
-            p.is_polygon(pair.i as usize) || (!pair.is_wall() && p.is_polygon(pair.j as usize));
-        if polygon && c.is_none() {
+        let (c, hint) = area_candidate(s, law, pair, hint);
+        let Some(c) = c else {
             return (None, hint);
-        }
-        let (g, input) = area_kinematics(s, pair, history, c.unwrap_or_default());
+        };
+        let (g, input) = area_kinematics(s, pair, history, c);
         (g, input, hint)
     } else {
         let Some((g, d)) = disk_candidate(s, law, pair) else {
@@ -224,6 +214,49 @@ fn disk_candidate_force<L: Law>(
 /// the law) that the processor cannot overlap with the next; the first half of several
 /// candidates side by side keeps it busy. Each candidate's arithmetic is unchanged.
 const DISK_BLOCK: usize = 16;
+
+/// Candidates of the overlap-area law evaluated per block (`candidates_with`), as
+/// [`DISK_BLOCK`].
+const AREA_BLOCK: usize = 16;
+
+/// The overlap-area law's first half of `candidate_force_hinted`: the overlap of a
+/// candidate that touches (zero area for disks whose circles touch), None when it does
+/// not, and the pair's hint for the next step.
+#[inline(always)]
+fn area_candidate<L: Law>(
+    s: &StepState,
+    law: &L,
+    pair: Pair,
+    hint: Hint,
+) -> (Option<AreaContact>, Hint) {
+    let (p, c) = (s.particles, s.corners);
+    let (i, j) = (pair.i as usize, pair.j as usize);
+    if !pair.is_wall() && !c.of(i).is_empty() && !c.of(j).is_empty() {
+        let d = offset(p, i, j);
+        // The circumscribed circles within range (`contacts::circles_touch`), squared.
+        let (ri, rj) = (p.radius[i], p.radius[j]);
+        let reach = law.range_factor() * (ri + rj);
+        if !(d[0] * d[0] + d[1] * d[1] < reach * reach) {
+            return (None, Hint::NONE);
+        }
+        return polygon_polygon_hinted(
+            &c.outline(i, [0.0; 2], ri),
+            &c.outline(j, [-d[0], -d[1]], rj),
+            d,
+            hint,
+        );
+    }
+    if !crate::contacts::circles_touch(s.particles, s.walls, law.range_factor(), pair) {
+        return (None, Hint::NONE);
+    }
+    let (c, hint) = area_contact_hinted(s.particles, s.corners, s.walls, pair, hint);
+    // Polygons touch when their outlines overlap (disks: when their circles do).
+    let polygon = p.is_polygon(i) || (!pair.is_wall() && p.is_polygon(j));
+    if polygon && c.is_none() {
+        return (None, hint);
+    }
+    (Some(c.unwrap_or_default()), hint)
+}
 
 /// Whether a contact shows a diverging state: a non-finite force, or an overlap beyond
 /// `max_overlap` of the smaller radius (limits.max_overlap).
@@ -525,9 +558,28 @@ fn candidates_with<L: Law>(
         };
         crate::parallel::for_each_block2(&mut out.kicks, &mut out.history, DISK_BLOCK, block);
     } else {
-        crate::parallel::for_each2(&mut out.kicks, &mut out.history, |k, kick, h| {
-            evaluate(k, kick, h);
-        });
+        // As the disks' blocks: first every candidate's overlap in the block, then the
+        // law for those that touch, so that one candidate's long chain of dependent
+        // steps (crossings, a square root, divisions, then the law's) overlaps the
+        // next's. Each candidate's arithmetic is unchanged.
+        let block = |k0: usize, kicks: &mut [Kick], h: &mut [f64]| {
+            let pairs = &list.pairs[k0..k0 + kicks.len()];
+            let mut geometry = [None; AREA_BLOCK];
+            for (m, (g, &pair)) in geometry.iter_mut().zip(pairs).enumerate() {
+                let (c, hint) = area_candidate(s, law, pair, list.hints.get(k0 + m));
+                list.hints.set(k0 + m, hint);
+                *g = c;
+            }
+            for (m, (kick, h)) in kicks.iter_mut().zip(h).enumerate() {
+                let k = k0 + m;
+                let r = geometry[m].map(|c| {
+                    let (g, input) = area_kinematics(s, pairs[m], list.history[k], c);
+                    contact_force(s.particles, |c| law.evaluate(c), pairs[m], &g, &input)
+                });
+                settle(k, r, kick, h);
+            }
+        };
+        crate::parallel::for_each_block2(&mut out.kicks, &mut out.history, AREA_BLOCK, block);
     }
     let key = first.into_inner();
     out.diverging = (key != u64::MAX).then(|| {
@@ -710,42 +762,6 @@ fn material_velocity(
     ([v[0] + w[0], v[1] + w[1]], s.particles.mass[j])
 }
 
-/// `candidate_force_hinted` for a pair of polygons (None for any other pair): the broad
-/// test, the overlap from the hint and the law, with the pair's offset taken once.
-#[inline(always)]
-fn polygon_pair<L: Law>(
-    s: &StepState,
-    law: &L,
-    pair: Pair,
-    history: f64,
-    hint: Hint,
-) -> Option<(Option<(ContactForce, f64)>, Hint)> {
-    let (p, c) = (s.particles, s.corners);
-    let (i, j) = (pair.i as usize, pair.j as usize);
-    if pair.is_wall() || c.of(i).is_empty() || c.of(j).is_empty() {
-        return None;
-    }
-    let d = offset(p, i, j);
-    // The circumscribed circles within range (`contacts::circles_touch`), squared.
-    let (ri, rj) = (p.radius[i], p.radius[j]);
-    let reach = law.range_factor() * (ri + rj);
-    if !(d[0] * d[0] + d[1] * d[1] < reach * reach) {
-        return Some((None, Hint::NONE));
-    }
-    let (contact, hint) = polygon_polygon_hinted(
-        &c.outline(i, [0.0; 2], ri),
-        &c.outline(j, [-d[0], -d[1]], rj),
-        d,
-        hint,
-    );
-    let Some(contact) = contact else {
-        return Some((None, hint));
-    };
-    let (g, input) = area_kinematics(s, pair, history, contact);
-    let r = contact_force(s.particles, |c| law.evaluate(c), pair, &g, &input);
-    Some((Some(r), hint))
-}
-
 /// The overlap-area geometry of a pair (SPEC 2.3), whatever the shapes, in the frame of
 /// i's centre; None when they do not overlap.
 pub fn area_contact(
@@ -823,9 +839,11 @@ fn area_kinematics(
     } else {
         m1 * m2 / (m1 + m2)
     };
+    // One division for the two quotients by l.
+    let inv_l = if c.l > 0.0 { 1.0 / c.l } else { 0.0 };
     let (delta, depth) = if c.l > 0.0 {
         (
-            c.area / c.l,
+            c.area * inv_l,
             if c.chord > 0.0 { c.area / c.chord } else { 0.0 },
         )
     } else {
@@ -837,7 +855,7 @@ fn area_kinematics(
         delta,
         r: depth,
         sigma: 0.0,
-        delta_dot: if c.l > 0.0 { c.chord * v_n / c.l } else { 0.0 },
+        delta_dot: c.chord * v_n * inv_l,
         v_t: v12[0] * t[0] + v12[1] * t[1],
         m12,
         mass: 2.0 * m12,

@@ -26,8 +26,8 @@
 //! resumed from a checkpoint (which keeps no hints) stays bitwise the same as one that
 //! went on.
 
-use super::polygon::{Outline, along};
-use super::{AreaContact, dot, norm, reduced_arm, sub, unit_or_up};
+use super::polygon::{Outline, along, chord_frame};
+use super::{AreaContact, dot, norm, pair_scale, reduced_arm, sub, unit_or_up};
 use crate::geometry::cross;
 use crate::shape::P2;
 
@@ -160,9 +160,13 @@ pub fn separated_by(a: &Outline, k: usize, b: &Outline, corner: &mut usize) -> b
 
 /// Whether an overlap of this area, whose outline's corners lie in the box [lo, hi], is
 /// too thin to make a contact (`THICKNESS_FLOOR`).
+/// Compared in squares (area ≥ 0 here; no square root on the step's hottest path): a
+/// NaN area is below it, as before.
+#[inline(always)]
 pub fn below_floor(p: &Outline, q: &Outline, area: f64, (lo, hi): (P2, P2)) -> bool {
-    let span = norm(sub(hi, lo));
-    !(area > THICKNESS_FLOOR * (p.reach + q.reach) * span)
+    let e = sub(hi, lo);
+    let floor = THICKNESS_FLOOR * (p.reach + q.reach);
+    !(area > 0.0 && area * area > floor * floor * dot(e, e))
 }
 
 /// The box [lo, hi] grown to hold x.
@@ -195,7 +199,7 @@ fn crossing(
     f: usize,
     entering: bool,
     room: f64,
-) -> Option<(f64, f64, P2)> {
+) -> Option<(f64, [f64; 2], P2)> {
     let (x, y) = (p.at(e), p.at(p.next_corner(e)));
     let (a, b) = (q.at(f), q.at(q.next_corner(f)));
     let (pe, qe) = (sub(y, x), sub(b, a));
@@ -214,7 +218,15 @@ fn crossing(
         return None;
     }
     let t = dx / (dx - dy);
-    Some((t, da / (da - db), along(x, y, t)))
+    // The parameter along q's edge matters only when both crossings lie on one edge of
+    // q (`chain_length`): its division is left to the caller.
+    Some((t, [da, db], along(x, y, t)))
+}
+
+/// The parameter along q's edge of a crossing from its side values [da, db].
+#[inline(always)]
+fn parameter([da, db]: [f64; 2]) -> f64 {
+    da / (da - db)
 }
 
 /// How many corners a chain of `a` takes from the crossing on edge `from` to the one on
@@ -273,7 +285,11 @@ pub fn rest(p: &Outline, q: &Outline, d: P2, c: Chain) -> Option<Option<AreaCont
     let (t_out, r_out, x_out) = crossing(p, c.e_out, q, c.f_out, false, room)?;
     let lp = chain_length(np, c.e_in, c.e_out, t_in, t_out)?;
     // q's run goes from the crossing out (q entering p) to the crossing in.
-    let lq = chain_length(nq, c.f_out, c.f_in, r_out, r_in)?;
+    let lq = if c.f_out == c.f_in {
+        chain_length(nq, c.f_out, c.f_in, parameter(r_out), parameter(r_in))?
+    } else {
+        chain_length(nq, c.f_out, c.f_in, 0.0, 0.0)?
+    };
     let (mut area2, mut prev) = (0.0, x_in);
     let mut span = NO_BOX;
     hold(&mut span, x_in);
@@ -310,30 +326,20 @@ pub fn rest(p: &Outline, q: &Outline, d: P2, c: Chain) -> Option<Option<AreaCont
     if below_floor(p, q, area, span) {
         return Some(None);
     }
-    let scale = norm(d) + p.reach + q.reach;
-    let e = sub(x_out, x_in);
-    let chord = norm(e);
-    let (n, point, chord) = if chord > 1e-12 * scale {
-        let t = [e[0] / chord, e[1] / chord];
-        let mut n = [-t[1], t[0]];
-        let s = [0.5 * (x_in[0] + x_out[0]), 0.5 * (x_in[1] + x_out[1])];
-        // Corners of i inside j lie on j's side of the line, corners of j inside i on
-        // i's side; n points from j to i.
-        let (np, nq) = (lp as f64, lq as f64);
-        let side = dot(n, [p_sum[0] - np * s[0], p_sum[1] - np * s[1]])
-            - dot(n, [q_sum[0] - nq * s[0], q_sum[1] - nq * s[1]]);
-        if side > 0.0 || (side == 0.0 && dot(n, d) < 0.0) {
-            n = [-n[0], -n[1]];
+    let scale = pair_scale(p, q, d);
+    let (np, nq) = (lp as f64, lq as f64);
+    let (n, point, chord) = match chord_frame(x_in, x_out, (p_sum, np), (q_sum, nq), d, scale) {
+        Some(frame) => frame,
+        None => {
+            // A vanishing chord: n along the centres, S at the mean of the outline's
+            // corners.
+            let k = (lp + lq + 2) as f64;
+            let s = [
+                (p_sum[0] + q_sum[0] + x_in[0] + x_out[0]) / k,
+                (p_sum[1] + q_sum[1] + x_in[1] + x_out[1]) / k,
+            ];
+            (unit_or_up(d), s, 0.0)
         }
-        (n, s, chord)
-    } else {
-        // A vanishing chord: n along the centres, S at the mean of the outline's corners.
-        let k = (lp + lq + 2) as f64;
-        let s = [
-            (p_sum[0] + q_sum[0] + x_in[0] + x_out[0]) / k,
-            (p_sum[1] + q_sum[1] + x_in[1] + x_out[1]) / k,
-        ];
-        (unit_or_up(d), s, 0.0)
     };
     // S − r_j = S + d.
     let l = reduced_arm(norm(point), norm([point[0] + d[0], point[1] + d[1]]), scale);

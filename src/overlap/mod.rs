@@ -77,6 +77,13 @@ pub(crate) fn corner_mean(v: &[P2]) -> P2 {
     [s[0] / n, s[1] / n]
 }
 
+/// A polygon pair's length scale for its tolerances: |d|₁ + r_p + r_q (the 1-norm: a
+/// scale needs no square root).
+#[inline(always)]
+pub(crate) fn pair_scale(p: &polygon::Outline, q: &polygon::Outline, d: P2) -> f64 {
+    d[0].abs() + d[1].abs() + p.reach + q.reach
+}
+
 /// l = 1/(1/l_i + 1/l_j), with a floor so that a force point on a centre (a diverging
 /// overlap) gives a large but finite force.
 pub(crate) fn reduced_arm(li: f64, lj: f64, scale: f64) -> f64 {

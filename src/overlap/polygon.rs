@@ -34,7 +34,7 @@
 use super::hint::{
     Chain, Hint, NO_BOX, Seen, below_floor, hold, rest, separated_by, separating_edge,
 };
-use super::{AreaContact, dot, norm, reduced_arm, sub, unit_or_up};
+use super::{AreaContact, dot, norm, pair_scale, reduced_arm, sub, unit_or_up};
 use crate::geometry::cross;
 use crate::shape::{MAX_CORNERS, P2};
 
@@ -274,6 +274,39 @@ pub(super) fn along(x: P2, y: P2, t: f64) -> P2 {
     [x[0] + t * (y[0] - x[0]), x[1] + t * (y[1] - x[1])]
 }
 
+/// The normal, force point and chord of an overlap whose outline crosses from p into q
+/// at xa and back at xb (paper 000 sec. 2.2: n perpendicular to the line through the
+/// crossings, S at its midpoint, n pointing from j to i), given the sums and counts of
+/// p's corners inside q and of q's inside p; None when the chord vanishes (below 10⁻¹²
+/// of the pair's `scale`). Which way n points is decided by the unnormalised normal,
+/// whose sign is all that matters: the square root and the division that make n a unit
+/// vector then run beside that test instead of before it.
+#[inline(always)]
+pub(super) fn chord_frame(
+    xa: P2,
+    xb: P2,
+    (sum_p, n_p): (P2, f64),
+    (sum_q, n_q): (P2, f64),
+    d: P2,
+    scale: f64,
+) -> Option<(P2, P2, f64)> {
+    let e = sub(xb, xa);
+    let (e2, small) = (dot(e, e), 1e-12 * scale);
+    if !(e2 > small * small) {
+        return None;
+    }
+    let m = [-e[1], e[0]];
+    let s = [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])];
+    // Corners of i inside j lie on j's side of the line, corners of j inside i on i's
+    // side.
+    let side = dot(m, [sum_p[0] - n_p * s[0], sum_p[1] - n_p * s[1]])
+        - dot(m, [sum_q[0] - n_q * s[0], sum_q[1] - n_q * s[1]]);
+    let flip = side > 0.0 || (side == 0.0 && dot(m, d) < 0.0);
+    let chord = e2.sqrt();
+    let inv = if flip { -1.0 / chord } else { 1.0 / chord };
+    Some(([m[0] * inv, m[1] * inv], s, chord))
+}
+
 /// Crossing k of `in_p` (bit k of `cross`): p's edge and q's edge that cross there.
 fn crossing_edges(in_p: &Inside, k: usize) -> (usize, usize) {
     let e = k >> 1;
@@ -455,7 +488,7 @@ fn cut_out(p: &Outline, q: &Outline, d: P2) -> (Option<AreaContact>, Hint) {
     if n_p + n_q + n_x < 3 {
         return (None, apart());
     }
-    let scale = norm(d) + p.reach + q.reach;
+    let scale = pair_scale(p, q, d);
     // The two crossings farthest apart (more than two: nearly parallel edges; they span
     // the thin overlap along its length).
     let (mut best, mut xa, mut xb) = (-1.0, [0.0; 2], [0.0; 2]);
@@ -467,29 +500,19 @@ fn cut_out(p: &Outline, q: &Outline, d: P2) -> (Option<AreaContact>, Hint) {
             }
         }
     }
-    let chord = best.max(0.0).sqrt();
-    let (n, point, chord) = if best >= 0.0 && chord > 1e-12 * scale {
-        let t = [(xb[0] - xa[0]) / chord, (xb[1] - xa[1]) / chord];
-        let mut n = [-t[1], t[0]];
-        let s = [0.5 * (xa[0] + xb[0]), 0.5 * (xa[1] + xb[1])];
-        // Corners of i inside j lie on j's side of the line, corners of j inside i on
-        // i's side; n points from j to i.
-        let (np, nq) = (n_p as f64, n_q as f64);
-        let side = dot(n, [in_p.sum[0] - np * s[0], in_p.sum[1] - np * s[1]])
-            - dot(n, [q_sum[0] - nq * s[0], q_sum[1] - nq * s[1]]);
-        if side > 0.0 || (side == 0.0 && dot(n, d) < 0.0) {
-            n = [-n[0], -n[1]];
+    let (np, nq) = (n_p as f64, n_q as f64);
+    let (n, point, chord) = match chord_frame(xa, xb, (in_p.sum, np), (q_sum, nq), d, scale) {
+        Some(frame) if best >= 0.0 => frame,
+        _ => {
+            // Fewer than two crossings or a vanishing chord: n along the centres, S at
+            // the mean of the overlap's corners.
+            let k = (n_p + n_q + n_x) as f64;
+            let s = [
+                (in_p.sum[0] + q_sum[0] + in_p.cross_sum[0]) / k,
+                (in_p.sum[1] + q_sum[1] + in_p.cross_sum[1]) / k,
+            ];
+            (unit_or_up(d), s, 0.0)
         }
-        (n, s, chord)
-    } else {
-        // Fewer than two crossings or a vanishing chord: n along the centres, S at the
-        // mean of the overlap's corners.
-        let k = (n_p + n_q + n_x) as f64;
-        let s = [
-            (in_p.sum[0] + q_sum[0] + in_p.cross_sum[0]) / k,
-            (in_p.sum[1] + q_sum[1] + in_p.cross_sum[1]) / k,
-        ];
-        (unit_or_up(d), s, 0.0)
     };
     let area2 = in_p.area2 + in_q.area2 + chain2;
     let area = 0.5 * area2;
