@@ -243,6 +243,29 @@ mod tests {
         assert!(t < 5e7 / 1e6 && t > 5e7 / 4e6 && slow > 0.0, "{t}");
     }
 
+    /// heap_50k's outlet as first written (grains dropped at 0.2 m/s, 200 a second)
+    /// keeps about a third of its rate: a grain still covers its spot when the next
+    /// falls due. At 2.5 m/s (the scene now) it keeps up; `at_pace` scales the rate.
+    #[test]
+    fn a_slow_drop_holds_its_source_back_and_the_pace_says_so() {
+        let text = include_str!("../../scenes/heap_50k.json");
+        let pace_at = |speed: &str| {
+            let o = vec![format!("particles.0.velocity=[0.0,{speed}]")];
+            let mut sim = Simulation::new(crate::scene::parse(text, &o).unwrap()).unwrap();
+            // 1.2 time units: 240 grains due.
+            sim.advance(60_000).unwrap();
+            source_pace(&sim)[0]
+        };
+        let (slow, fast) = (pace_at("-0.2"), pace_at("-2.5"));
+        assert!(slow < 0.6, "at 0.2 m/s the source keeps {slow} of its rate");
+        assert!(fast > 0.97, "at 2.5 m/s the source keeps {fast} of its rate");
+        let s = crate::scene::parse(text, &[]).unwrap();
+        let Creation::PointSource(p) = &at_pace(&s, &[0.25]).particles[0] else {
+            panic!("heap_50k pours from a point source");
+        };
+        assert_eq!(p.rate, 50.0);
+    }
+
     #[test]
     fn the_grown_pile_holds_about_the_count_of_the_source() {
         let s = crate::scene::parse(crate::scene::DEFAULT_SCENE, &[]).unwrap();
