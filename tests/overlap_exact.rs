@@ -213,6 +213,15 @@ fn config(rng: &mut Rng, kind: Kind) -> Pair {
     }
 }
 
+/// Every kind of configuration the tests draw.
+const KINDS: [Kind; 5] = [
+    Kind::Random,
+    Kind::Parallel,
+    Kind::SharedCorner,
+    Kind::Inside,
+    Kind::Spike,
+];
+
 /// Every kind, many times: the area agrees with the exact clip's to 1e-9 relative or
 /// 64 ε of the polygons' size squared (the corners' own rounding), and an overlap the
 /// code does not report is below its floor (`THICKNESS_FLOOR` of the radii times the
@@ -221,14 +230,7 @@ fn config(rng: &mut Rng, kind: Kind) -> Pair {
 #[test]
 fn the_overlap_area_is_the_exact_clips() {
     let mut rng = Rng::new(37);
-    let kinds = [
-        Kind::Random,
-        Kind::Parallel,
-        Kind::SharedCorner,
-        Kind::Inside,
-        Kind::Spike,
-    ];
-    for kind in kinds {
+    for kind in KINDS {
         let (mut overlapping, mut apart) = (0, 0);
         for _ in 0..300 {
             let c = config(&mut rng, kind);
@@ -287,14 +289,7 @@ fn same(a: &(Option<AreaContact>, Hint), b: &(Option<AreaContact>, Hint)) -> boo
 fn a_hint_never_changes_a_contact() {
     let mut rng = Rng::new(38);
     let (mut resting, mut apart, mut total) = (0, 0, 0);
-    let kinds = [
-        Kind::Random,
-        Kind::Parallel,
-        Kind::SharedCorner,
-        Kind::Inside,
-        Kind::Spike,
-    ];
-    for kind in kinds {
+    for kind in KINDS {
         for _ in 0..400 {
             let c = config(&mut rng, kind);
             let cold = c.contact(Hint::NONE);
