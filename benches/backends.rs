@@ -29,6 +29,7 @@ fn main() {
             kernels: false,
         },
         &mut |l| eprintln!("{l}"),
+        &mut |_| {},
     ) {
         Ok(r) => println!("{}", serde_json::to_string_pretty(&r).unwrap()),
         Err(e) => {

@@ -218,6 +218,26 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Run the benchmark workloads on the GPU path and the CPU path for the same steps
+    /// and compare the end states: positions, pair forces, contacts, each against a
+    /// stated tolerance; prints JSON, exits non-zero when a workload disagrees
+    Agree {
+        /// Packing sizes (disks).
+        #[arg(long, value_delimiter = ',', default_values_t = [100000])]
+        sizes: Vec<usize>,
+        /// Polygon-pile sizes (regular 12-gons).
+        #[arg(long, value_delimiter = ',', default_values_t = [30000])]
+        polygon_sizes: Vec<usize>,
+        /// Rod-pile sizes (aspect 5, paper 004's law).
+        #[arg(long, value_delimiter = ',')]
+        rod_sizes: Vec<usize>,
+        /// Steps run on each path.
+        #[arg(long, default_value_t = 300)]
+        steps: u64,
+        /// Write the JSON here too (atomically).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 pub fn main() -> ExitCode {
@@ -355,6 +375,13 @@ fn command(command: Command, threads: usize) -> ExitCode {
             kernels,
             out,
         ),
+        Command::Agree {
+            sizes,
+            polygon_sizes,
+            rod_sizes,
+            steps,
+            out,
+        } => cmd_agree((&sizes, &polygon_sizes, &rod_sizes), steps, out),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -1289,16 +1316,41 @@ fn choose_engine(
 /// Seconds per workload of a `talus bench` without --steps or --budget.
 const DEFAULT_BUDGET: f64 = 3.0;
 
-fn cmd_bench(
-    backends: &[Backend],
+fn cmd_agree(
     (sizes, polygon_sizes, rod_sizes): (&[usize], &[usize], &[usize]),
-    (steps, budget): (Option<u64>, Option<f64>),
-    pour: bool,
-    kernels: bool,
+    steps: u64,
     out: Option<PathBuf>,
 ) -> Result<(), Failure> {
-    // A workload is built in memory first: at most 2·10⁷ particles (issue 16: --sizes
-    // 3e8 aborted on allocation).
+    check_sizes(sizes, polygon_sizes, rod_sizes)?;
+    if steps == 0 {
+        return Err(Failure::input("--steps must be at least 1"));
+    }
+    let report = bench::agree::run(sizes, polygon_sizes, rod_sizes, steps, &mut |line| {
+        eprintln!("{line}")
+    })?;
+    let text = serde_json::to_string_pretty(&report).expect("report serialises");
+    out!("{text}");
+    if let Some(path) = out {
+        talus::files::write_atomic(&path, text.as_bytes())
+            .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
+    }
+    let disagree = report.results.iter().filter(|a| !a.passed).count();
+    if disagree + report.failures.len() > 0 {
+        return Err(Failure::failed(format!(
+            "{disagree} of the workloads disagree beyond their tolerance and {} could not run",
+            report.failures.len()
+        )));
+    }
+    Ok(())
+}
+
+/// A workload is built in memory first: at most 2·10⁷ particles (issue 16: --sizes 3e8
+/// aborted on allocation).
+fn check_sizes(
+    sizes: &[usize],
+    polygon_sizes: &[usize],
+    rod_sizes: &[usize],
+) -> Result<(), Failure> {
     for (flag, list) in [
         ("--sizes", sizes),
         ("--polygon-sizes", polygon_sizes),
@@ -1310,6 +1362,18 @@ fn cmd_bench(
             )));
         }
     }
+    Ok(())
+}
+
+fn cmd_bench(
+    backends: &[Backend],
+    (sizes, polygon_sizes, rod_sizes): (&[usize], &[usize], &[usize]),
+    (steps, budget): (Option<u64>, Option<f64>),
+    pour: bool,
+    kernels: bool,
+    out: Option<PathBuf>,
+) -> Result<(), Failure> {
+    check_sizes(sizes, polygon_sizes, rod_sizes)?;
     if let Some(b) = budget.filter(|b| !(*b > 0.0 && b.is_finite())) {
         return Err(Failure::input(format!(
             "--budget must be a positive number of seconds, got {b}"
@@ -1333,6 +1397,14 @@ fn cmd_bench(
             kernels,
         },
         &mut |line| eprintln!("{line}"),
+        &mut |so_far| {
+            // Each measurement as it ends (issue 38: a bench stopped at a time limit keeps
+            // the workloads it finished); a write that fails is reported at the end.
+            if let Some(path) = &out {
+                let text = serde_json::to_string_pretty(so_far).expect("report serialises");
+                let _ = talus::files::write_atomic(path, text.as_bytes());
+            }
+        },
     )?;
     let text = serde_json::to_string_pretty(&report).expect("report serialises");
     out!("{text}");

@@ -203,7 +203,7 @@ fn the_command_writes_its_tables_and_rejects_bad_input() {
     let dir = tmp("command");
     let json = talus::snapshot::write(&s, &dir, "snap").unwrap();
     let run = |args: &[&str]| {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+        let out = std::process::Command::new(common::talus_bin())
             .args(args)
             .output()
             .unwrap();
@@ -335,7 +335,7 @@ fn damaged_snapshots_are_refused_by_analyze_and_render() {
             "{name}: {e:?}"
         );
         for cmd in ["analyze", "render"] {
-            let out = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+            let out = std::process::Command::new(common::talus_bin())
                 .args([cmd, d.join("snap.json").to_str().unwrap()])
                 .output()
                 .unwrap();
@@ -368,7 +368,7 @@ fn render_draws_pictures_and_vtk_files_of_the_column() {
     let dir = tmp("render");
     let json = talus::snapshot::write(&s, &dir, "snap").unwrap();
     let out = dir.join("pictures");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+    let o = std::process::Command::new(common::talus_bin())
         .args([
             "render",
             json.to_str().unwrap(),
@@ -487,7 +487,7 @@ fn reproduce_r1_gives_the_papers_stress_ratio_of_one_third() {
     // interior of the first mobile row S_xx/S_zz = tan² 30° = 1/3, for ν = 1 and 3/2.
     let dir = tmp("reproduce");
     let run = |args: &[&str]| {
-        let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+        let o = std::process::Command::new(common::talus_bin())
             .args(args)
             .output()
             .unwrap();
@@ -531,7 +531,7 @@ fn reproduce_r1_gives_the_papers_stress_ratio_of_one_third() {
 /// succeed: the folder and its reproduce.json.
 fn reproduce(name: &str, args: &[&str]) -> (PathBuf, serde_json::Value) {
     let dir = tmp(name);
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+    let o = std::process::Command::new(common::talus_bin())
         .arg("reproduce")
         .args(args)
         .args(["--backend", "cpu", "-q", "--out"])
@@ -624,7 +624,7 @@ fn reproduce_r2_dips_under_a_squeezed_bottom_only() {
         "S_zz(1) under the apex falls with the squeeze"
     );
     // --reuse measures a finished run again without running it; --only picks it.
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+    let o = std::process::Command::new(common::talus_bin())
         .args([
             "reproduce",
             "R2",
@@ -712,7 +712,7 @@ fn grains_that_rolled_away_do_not_widen_the_heap() {
 #[test]
 fn a_run_with_output_vtk_writes_a_paraview_time_series() {
     let dir = tmp("vtk-run");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+    let o = std::process::Command::new(common::talus_bin())
         .args([
             "run",
             "-q",
@@ -751,7 +751,7 @@ fn a_run_with_output_vtk_writes_a_paraview_time_series() {
     // `talus render` writes from the snapshot files.
     let last = files[files.len() - 2].trim_end_matches("_grains.vtp");
     let out = dir.join("rendered");
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+    let o = std::process::Command::new(common::talus_bin())
         .args(["render", "--width", "64", "--out", out.to_str().unwrap()])
         .arg(dir.join("snapshots").join(format!("{last}.json")))
         .output()

@@ -36,14 +36,7 @@ fn gpu_sim(test: &str, scene: talus::scene::Scene) -> Option<GpuSimulation> {
 /// Largest position difference of the particles both runs have, in diameters (d = 1
 /// in these reduced scenes; the SI pile passes its diameter).
 fn max_position_difference(a: &Simulation, b: &Simulation, d: f64) -> f64 {
-    let n = a.particles.len().min(b.particles.len());
-    (0..n)
-        .filter(|&i| a.particles.active[i] && b.particles.active[i])
-        .map(|i| {
-            let (p, q) = (a.particles.position(i), b.particles.position(i));
-            (p[0] - q[0]).abs().max((p[1] - q[1]).abs()) / d
-        })
-        .fold(0.0, f64::max)
+    talus::bench::agree::max_position_difference(a, b, d)
 }
 
 struct Stats {
@@ -133,26 +126,10 @@ fn r4_pour_agrees_with_the_cpu_then_statistically() {
 
 /// Worst difference of the normal forces pair by pair over the union of both contact
 /// lists (a missing contact counts as zero force), in units of the CPU's mean force;
-/// and the relative difference of the total vertical contact force.
+/// the relative difference of the total vertical contact force; both contact counts.
 fn pair_force_difference(gs: &Simulation, cpu: &Simulation) -> (f64, f64, usize, usize) {
-    let forces = |s: &Simulation| -> std::collections::BTreeMap<(u32, u32), f64> {
-        s.pairs
-            .iter()
-            .zip(&s.contacts)
-            .map(|(p, c)| ((p.i, p.j), c.f_n))
-            .collect()
-    };
-    let (fg, fc) = (forces(gs), forces(cpu));
-    let mean = fc.values().sum::<f64>() / fc.len() as f64;
-
-    let worst = fg
-        .keys()
-        .chain(fc.keys())
-        .map(|k| (fg.get(k).unwrap_or(&0.0) - fc.get(k).unwrap_or(&0.0)).abs() / mean)
-        .fold(0.0, f64::max);
-    let total = |s: &Simulation| s.contacts.iter().map(|c| c.force[1]).sum::<f64>();
-    let (a, b) = (total(gs), total(cpu));
-    (worst, (a - b).abs() / b.abs(), fg.len(), fc.len())
+    let f = talus::bench::agree::pair_force_difference(gs, cpu);
+    (f.worst, f.vertical_sum, f.contacts_a, f.contacts_b)
 }
 
 #[test]
@@ -934,6 +911,30 @@ fn gear_predicting_ahead_changes_no_bit() {
             ahead.download().contacts,
             stepwise.download().contacts,
             "{name}: the same contacts"
+        );
+    }
+}
+
+#[test]
+fn talus_agree_finds_the_bench_workloads_alike_on_both_paths() {
+    // `talus agree` (scripts/gpu-check's agreement phase) on small cuts of its
+    // workloads: each judged against its stated tolerance, and the verdict follows the
+    // figures.
+    if common::gpu("talus_agree_finds_the_bench_workloads_alike").is_none() {
+        return;
+    }
+    let r =
+        talus::bench::agree::run(&[2000], &[1000], &[], 200, &mut |l| eprintln!("{l}")).unwrap();
+    assert!(r.failures.is_empty(), "{:?}", r.failures);
+    assert_eq!(r.results.len(), 2);
+    for a in &r.results {
+        let t = a.tolerance.expect("disks and polygons have tolerances");
+        assert!(a.passed, "{} disagrees: {a:?}", a.workload);
+        assert!(a.position_difference <= t.position && a.vertical_sum_difference <= t.vertical_sum);
+        assert!(
+            a.contacts_cpu > a.particles / 2,
+            "{}: the pile is in contact",
+            a.workload
         );
     }
 }

@@ -575,7 +575,7 @@ fn damaged_lengths_in_a_checkpoint_are_refused() {
 /// `talus run` on the CPU path with one thread (results are bitwise the same for any
 /// count; one leaves the other tests their cores).
 fn talus_run(args: &[&str]) -> std::process::Command {
-    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_talus"));
+    let mut c = std::process::Command::new(common::talus_bin());
     c.args(["--threads", "1", "run", "-q", "--backend", "cpu"])
         .args(args);
     c

@@ -156,7 +156,7 @@ fn a_run_with_copies_writes_each_as_a_run_of_its_own() {
     let dir = std::env::temp_dir().join(format!("talus-replicas-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let run = |out: &std::path::Path, set: &[&str]| {
-        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_talus"));
+        let mut c = std::process::Command::new(common::talus_bin());
         c.args(["--threads", "2", "run", "-q", "--backend", "cpu", "--out"])
             .arg(out);
         for s in [

@@ -361,7 +361,7 @@ fn rods_poured_into_a_box_settle_and_stop_by_their_mean_kinetic_energy() {
     let scene = dir.join("box.json");
     std::fs::write(&scene, v.to_string()).unwrap();
     let out = dir.join("run");
-    let status = std::process::Command::new(env!("CARGO_BIN_EXE_talus"))
+    let status = std::process::Command::new(common::talus_bin())
         .args([
             "run",
             scene.to_str().unwrap(),

@@ -26,6 +26,26 @@ pub const STORAGE_BUFFERS_NEEDED: u32 = super::kernels::GROUP0_STORAGE
 /// Params.
 pub const BUFFERS_NEEDED: u32 = STORAGE_BUFFERS_NEEDED + 1;
 
+/// The variable that sets [`wait_limit`], in seconds.
+pub const WAIT_LIMIT_VAR: &str = "TALUS_GPU_TIMEOUT";
+
+/// How long one wait for the device may take: `TALUS_GPU_TIMEOUT` seconds, by default
+/// 300 (a submission of 64 steps of the largest scene lavapipe holds takes about 30 s
+/// there; on a hardware GPU milliseconds). A value that is not a positive number of
+/// seconds is ignored with the default.
+pub fn wait_limit() -> std::time::Duration {
+    wait_limit_from(std::env::var(WAIT_LIMIT_VAR).ok().as_deref())
+}
+
+/// [`wait_limit`] from the variable's value.
+fn wait_limit_from(value: Option<&str>) -> std::time::Duration {
+    let seconds = value
+        .and_then(|v| v.trim().parse::<f64>().ok())
+        .filter(|s| *s > 0.0 && *s < 1e9)
+        .unwrap_or(300.0);
+    std::time::Duration::from_secs_f64(seconds)
+}
+
 #[derive(Debug, thiserror::Error)]
 pub enum DeviceError {
     #[error(
@@ -188,6 +208,26 @@ impl Gpu {
         note(&self.failure, reason)
     }
 
+    /// Waits until `submission` (None: everything submitted) is done, at most
+    /// [`wait_limit`]: a hung device stops the run with this error instead of hanging it
+    /// (issue 38).
+    pub fn wait(&self, submission: Option<wgpu::SubmissionIndex>) -> Result<(), String> {
+        let limit = wait_limit();
+        let polled = self.device.poll(wgpu::PollType::Wait {
+            submission_index: submission,
+            timeout: Some(limit),
+        });
+        match polled {
+            Ok(_) => Ok(()),
+            Err(wgpu::PollError::Timeout) => Err(format!(
+                "the device did not finish its work within {} s (set {WAIT_LIMIT_VAR} to wait \
+                 longer): it may be hung",
+                limit.as_secs_f64()
+            )),
+            Err(e) => Err(format!("the device was lost: {e}")),
+        }
+    }
+
     /// The first failure the device reported, if any.
     pub fn failure(&self) -> Option<String> {
         self.failure
@@ -287,4 +327,20 @@ fn note(slot: &std::sync::Mutex<Option<String>>, reason: String) {
     slot.lock()
         .unwrap_or_else(|p| p.into_inner())
         .get_or_insert(reason);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_wait_limit_is_a_positive_number_of_seconds_or_the_default() {
+        let secs = |v| wait_limit_from(v).as_secs_f64();
+        assert_eq!(secs(None), 300.0);
+        assert_eq!(secs(Some(" 60 ")), 60.0);
+        assert_eq!(secs(Some("0.5")), 0.5);
+        for bad in ["0", "-3", "inf", "NaN", "a minute", ""] {
+            assert_eq!(secs(Some(bad)), 300.0, "{bad:?}");
+        }
+    }
 }

@@ -384,12 +384,8 @@ impl GpuSimulation {
     /// the failure noted, when the device cannot be read: `failure`).
     pub(super) fn wait_for(&self, batch: Batch) -> Vec<u32> {
         let words = control::BLOCKED;
-        let polled = self.gpu.device.poll(wgpu::PollType::Wait {
-            submission_index: Some(batch.index),
-            timeout: None,
-        });
-        if let Err(e) = polled {
-            self.note_failure(format!("the device was lost: {e}"));
+        if let Err(e) = self.gpu.wait(Some(batch.index)) {
+            self.note_failure(e);
             return vec![0; words];
         }
         if let Err(e) = batch.mapped.outcome() {

@@ -329,9 +329,8 @@ impl GpuSimulation {
         let mapped = self.map_flag();
         let flag = mapped.clone();
         slice.map_async(wgpu::MapMode::Read, move |r| flag.set(r));
-        let polled = self.gpu.device.poll(wgpu::PollType::wait_indefinitely());
-        if let Err(e) = polled {
-            return self.failed(format!("the device was lost: {e}"), count);
+        if let Err(e) = self.gpu.wait(None) {
+            return self.failed(e, count);
         }
         if let Err(e) = mapped.outcome() {
             return self.failed(e, count);

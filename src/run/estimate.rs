@@ -258,7 +258,10 @@ mod tests {
         };
         let (slow, fast) = (pace_at("-0.2"), pace_at("-2.5"));
         assert!(slow < 0.6, "at 0.2 m/s the source keeps {slow} of its rate");
-        assert!(fast > 0.97, "at 2.5 m/s the source keeps {fast} of its rate");
+        assert!(
+            fast > 0.97,
+            "at 2.5 m/s the source keeps {fast} of its rate"
+        );
         let s = crate::scene::parse(text, &[]).unwrap();
         let Creation::PointSource(p) = &at_pace(&s, &[0.25]).particles[0] else {
             panic!("heap_50k pours from a point source");

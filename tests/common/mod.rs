@@ -9,6 +9,13 @@ pub mod mutate;
 pub mod pairs;
 pub mod wgsl;
 
+/// The talus binary that tests start: `TALUS_BIN` when set (`scripts/gpu-check` runs
+/// test binaries staged without cargo's target folder, beside a staged talus), else the
+/// one cargo built with the tests.
+pub fn talus_bin() -> std::path::PathBuf {
+    std::env::var_os("TALUS_BIN").map_or_else(|| env!("CARGO_BIN_EXE_talus").into(), Into::into)
+}
+
 /// A scene around `particles` and `contact`, with a large domain, no gravity by default.
 pub fn scene_value(contact: Value, particles: Value) -> Value {
     json!({

@@ -8,6 +8,8 @@
 //! (R8's particles) whose faces touch; gravity presses them into about six area contacts
 //! each. The first tenth of the steps is a warm-up and not timed.
 
+pub mod agree;
+
 use crate::gpu::GpuSimulation;
 use crate::gpu::device::BackendChoice;
 use crate::run::Engine;
@@ -43,6 +45,10 @@ pub struct Measurement {
     pub empty_dispatches_per_step: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub submissions_per_step: Option<f64>,
+    /// GPU path: every dispatch recorded per step, those that ran no workgroups
+    /// included (issue 38: each is a command the device must take in order).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub commands_per_step: Option<f64>,
     /// Neighbour-list rebuilds per 1000 steps (both paths), and on the CPU path the
     /// candidate pairs and contacts per particle at the end (issue 13).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -243,6 +249,7 @@ fn measure(
     let seconds = t.elapsed().as_secs_f64();
     let per_step = |c: u64| c as f64 / steps as f64;
     let (mut dispatches, mut between, mut empty, mut submissions) = (None, None, None, None);
+    let mut commands = None;
     if let (Some(c0), Some(c)) = (counters0, gpu_counters(&e)) {
         let stages = crate::gpu::REBUILD_STAGES.len() as u64;
         let (direct, indirect) = (c.direct - c0.direct, c.indirect - c0.indirect);
@@ -251,6 +258,7 @@ fn measure(
         between = Some(per_step(direct));
         empty = Some(per_step(indirect - ran));
         submissions = Some(per_step(c.submissions - c0.submissions));
+        commands = Some(per_step(direct + indirect));
     }
     // Moving particles (fixed ones are never integrated), as other DEM codes count.
     let n = (n0 + e.mobile_count()) / 2;
@@ -301,6 +309,7 @@ fn measure(
         dispatches_between_rebuilds: between,
         empty_dispatches_per_step: empty,
         submissions_per_step: submissions,
+        commands_per_step: commands,
         rebuilds_per_1000_steps: rebuilds,
         pairs_per_particle: pairs,
         contacts_per_particle: contacts,
@@ -309,7 +318,7 @@ fn measure(
     })
 }
 
-fn cpu_name() -> String {
+pub(crate) fn cpu_name() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|s| {
@@ -319,6 +328,40 @@ fn cpu_name() -> String {
                 .map(|v| v.trim().to_string())
         })
         .unwrap_or_else(|| "unknown".into())
+}
+
+/// The workloads by name, with their scenes: packings, polygon piles, rod piles, and
+/// with `pour` the reduced R4 pour in its own domain and in a wide one.
+fn workloads(
+    sizes: &[usize],
+    polygon_sizes: &[usize],
+    rod_sizes: &[usize],
+    pour: bool,
+) -> Vec<(String, String)> {
+    let mut workloads: Vec<(String, String)> = sizes
+        .iter()
+        .map(|&n| (format!("packing-{n}"), packing_scene(n)))
+        .collect();
+    workloads.extend(
+        polygon_sizes
+            .iter()
+            .map(|&n| (format!("polygon-pile-{n}"), polygon_pile_scene(n))),
+    );
+    workloads.extend(
+        rod_sizes
+            .iter()
+            .map(|&n| (format!("rod-pile-{n}"), rod_pile_scene(n))),
+    );
+    if pour {
+        let text = include_str!("../../scenes/r4_pour_reduced.json");
+        workloads.push(("r4-pour-reduced".into(), text.into()));
+        // The same pour in a domain 10⁴ σ wide and 10³ σ high: the cell search costs
+        // what the particles cost, not what the domain's area does (both paths).
+        let mut wide: serde_json::Value = serde_json::from_str(text).expect("scene file");
+        wide["domain"] = json!({ "x": [-5000.0, 5000.0], "z": [-1.0, 1000.0] });
+        workloads.push(("r4-pour-reduced-wide".into(), wide.to_string()));
+    }
+    workloads
 }
 
 /// How each workload is timed.
@@ -338,8 +381,10 @@ pub struct Timing {
 /// Steps of the profiled run of `Timing::kernels`.
 pub const KERNEL_STEPS: u64 = 128;
 
-/// Runs every workload on every backend; `log` receives one line per measurement. A
-/// workload that cannot run on a backend is recorded in `failures` and the rest go on.
+/// Runs every workload on every backend; `log` receives one line per measurement and
+/// `partial` the report so far after each (`talus bench --out` writes it, so that a run
+/// stopped at a time limit keeps what it measured: issue 38). A workload that cannot
+/// run on a backend is recorded in `failures` and the rest go on.
 pub fn run(
     backends: &[BackendChoice],
     sizes: &[usize],
@@ -347,6 +392,7 @@ pub fn run(
     rod_sizes: &[usize],
     timing: Timing,
     log: &mut dyn FnMut(String),
+    partial: &mut dyn FnMut(&Report),
 ) -> Result<Report, BenchError> {
     let Timing {
         steps,
@@ -354,8 +400,13 @@ pub fn run(
         pour,
         kernels,
     } = timing;
-    let mut results = Vec::new();
-    let mut failures = Vec::new();
+    let mut report = Report {
+        cpu: cpu_name(),
+        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+        threads: rayon::current_num_threads(),
+        results: Vec::new(),
+        failures: Vec::new(),
+    };
     // `auto`: the GPU path on a hardware adapter; a software one (lavapipe) only when
     // asked for by `gpu` (it would take minutes and measure the CPU twice).
     let mut backends = backends.to_vec();
@@ -378,30 +429,7 @@ pub fn run(
             backends.push(g);
         }
     }
-    let mut workloads: Vec<(String, String)> = sizes
-        .iter()
-        .map(|&n| (format!("packing-{n}"), packing_scene(n)))
-        .collect();
-    workloads.extend(
-        polygon_sizes
-            .iter()
-            .map(|&n| (format!("polygon-pile-{n}"), polygon_pile_scene(n))),
-    );
-    workloads.extend(
-        rod_sizes
-            .iter()
-            .map(|&n| (format!("rod-pile-{n}"), rod_pile_scene(n))),
-    );
-    if pour {
-        let text = include_str!("../scenes/r4_pour_reduced.json");
-        workloads.push(("r4-pour-reduced".into(), text.into()));
-        // The same pour in a domain 10⁴ σ wide and 10³ σ high: the cell search costs
-        // what the particles cost, not what the domain's area does (both paths).
-        let mut wide: serde_json::Value = serde_json::from_str(text).expect("scene file");
-        wide["domain"] = json!({ "x": [-5000.0, 5000.0], "z": [-1.0, 1000.0] });
-        workloads.push(("r4-pour-reduced-wide".into(), wide.to_string()));
-    }
-    for (name, text) in &workloads {
+    for (name, text) in &workloads(sizes, polygon_sizes, rod_sizes, pour) {
         let invalid = |source| BenchError::Scene {
             workload: name.clone(),
             source,
@@ -420,11 +448,12 @@ pub fn run(
                 Err(error) => {
                     let backend = format!("{b:?}").to_lowercase();
                     log(format!("{name:>18} {backend:>28} failed: {error}"));
-                    failures.push(Failure {
+                    report.failures.push(Failure {
                         workload: name.clone(),
                         backend,
                         error: error.to_string(),
                     });
+                    partial(&report);
                     continue;
                 }
             };
@@ -440,10 +469,11 @@ pub fn run(
                 m.dispatches_between_rebuilds,
                 m.empty_dispatches_per_step,
                 m.submissions_per_step,
+                m.commands_per_step,
             ) {
-                (Some(d), Some(b), Some(e), Some(s)) => format!(
-                    ", {d:.1} dispatches ({b:.0} between rebuilds, {e:.1} empty) and \
-                     {s:.3} submissions per step"
+                (Some(d), Some(b), Some(e), Some(s), Some(c)) => format!(
+                    ", {d:.1} dispatches ({b:.0} between rebuilds, {e:.1} empty), {c:.1} \
+                     commands and {s:.3} submissions per step"
                 ),
                 _ => String::new(),
             };
@@ -475,16 +505,11 @@ pub fn run(
                     ));
                 }
             }
-            results.push(m);
+            report.results.push(m);
+            partial(&report);
         }
     }
-    Ok(Report {
-        cpu: cpu_name(),
-        cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
-        threads: rayon::current_num_threads(),
-        results,
-        failures,
-    })
+    Ok(report)
 }
 
 #[cfg(test)]
