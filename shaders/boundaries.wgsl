@@ -28,5 +28,6 @@ fn advance_clock() {
         if (rebuilding()) { atomicAdd(&control[C_REBUILDS], 1u); }
         let next = (lists_word() & (REMOVED | AHEAD_REBUILD)) != 0u;
         atomicStore(&control[C_LISTS], select(0u, REBUILD, next));
+        atomicStore(&control[C_STAGED], 0u);
     }
 }

@@ -31,6 +31,10 @@ const C_HALT_ID: u32 = 5u;
 const C_LISTS: u32 = 6u;
 // How many times the lists were built.
 const C_REBUILDS: u32 = 7u;
+// 1 while the step in progress was recorded with the rebuild stages (`plan_rebuild`
+// sets it, `advance_clock` clears it): a lean step, recorded without them (issue 38,
+// src/gpu/step.rs), pauses when it would need them (`lists_stale`).
+const C_STAGED: u32 = 8u;
 // Inactive particles counted by cell_index at a rebuild (they go last in the new memory
 // order, `permute_gather`).
 const C_INACTIVE: u32 = 9u;
@@ -54,6 +58,11 @@ const HALT_NOT_FINITE: u32 = 2u;
 const HALT_CONTACTS_FULL: u32 = 4u;
 const HALT_TABLE_FULL: u32 = 8u;
 const HALT_TOO_FAST: u32 = 16u;
+// Not a failure: a lean step found that it must rebuild the lists. Every kernel returns
+// (`halted`) until the next step recorded with the rebuild stages, whose `plan_rebuild`
+// lifts the pause and rebuilds from the paused, predicted state: the run goes on as if
+// the stages had been recorded in the paused step (bitwise the same).
+const HALT_PAUSED: u32 = 32u;
 // Candidates of one source looked at per step.
 const INSERT_WINDOW: u32 = 4u;
 
@@ -278,6 +287,11 @@ fn lists_word() -> u32 {
 // Whether this step rebuilds the neighbour lists.
 fn rebuilding() -> bool {
     return (lists_word() & REBUILD) != 0u;
+}
+
+// This step must rebuild the lists but was recorded without the rebuild stages.
+fn lists_stale() -> bool {
+    return rebuilding() && atomicLoad(&control[C_STAGED]) == 0u;
 }
 
 fn request_rebuild() {

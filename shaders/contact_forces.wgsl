@@ -52,6 +52,12 @@ fn velocity(i: u32) -> vec3<f32> {
 fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>,
                   @builtin(num_workgroups) groups: vec3<u32>) {
     if (halted()) { return; }
+    // A lean step whose survey asks for a rebuild pauses here (HALT_PAUSED): its
+    // candidates are stale. Every thread sees the same words, set by earlier dispatches.
+    if (lists_stale()) {
+        atomicOr(&control[C_HALT], HALT_PAUSED);
+        return;
+    }
     if (POLYGONS || SPHEROPOLYGONS) {
         let total = atomicLoad(&pairs.count);
         for (var t = gid.x; t < total; t += groups.x * WG) {

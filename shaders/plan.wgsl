@@ -16,7 +16,15 @@
 @compute @workgroup_size(WG)
 fn plan_rebuild(@builtin(local_invocation_index) l: u32) {
     let stages = arrayLength(&dispatch_args) / 8u;
-    let go = rebuilding() && !halted();
+    // A pause (a lean step before that needed the rebuild) ends here: the state is the
+    // paused step's, predicted and surveyed, and its rebuild runs now. Each thread
+    // decides from the word as it was; the first lifts the pause and notes the stages.
+    let h = atomicLoad(&control[C_HALT]);
+    let go = rebuilding() && (h & ~HALT_PAUSED) == 0u;
+    if (l == 0u) {
+        if (h == HALT_PAUSED) { atomicStore(&control[C_HALT], 0u); }
+        atomicStore(&control[C_STAGED], 1u);
+    }
     for (var k = l; k < stages; k += WG) {
         let full = 4u * k;
         let now = 4u * (stages + k);

@@ -938,3 +938,83 @@ fn talus_agree_finds_the_bench_workloads_alike_on_both_paths() {
         );
     }
 }
+
+#[test]
+fn lean_steps_change_no_bit() {
+    // Issue 38 item 2: between rebuilds a step records only its own work (no rebuild
+    // stages); a lean step whose survey asks for a rebuild pauses the device until the
+    // next step recorded with the stages (`STAGE_EVERY`), and the host submits the steps
+    // it lost. Piles that collapse (disks dropped by two diameters, a 60° pile of
+    // 12-gons under 10 g, rods dropped by one width) and a pour (insertions rebuild)
+    // with a small skin, so that many rebuilds fall in lean steps: bitwise the same as
+    // with the stages in every step, the same rebuilds, and fewer commands.
+    let drop = |text: String, rise: f64, g: f64| {
+        let mut v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        v["skin"] = json!(0.05);
+        v["gravity"]["g"] = json!([0.0, -g]);
+        for block in v["particles"].as_array_mut().unwrap() {
+            if let Some(z) = block.get_mut("start").and_then(|s| s.get_mut(1)) {
+                *z = json!(z.as_f64().unwrap() + rise);
+            }
+            if let Some(list) = block.get_mut("particles").and_then(|l| l.as_array_mut()) {
+                for p in list {
+                    p["position"][1] = json!(p["position"][1].as_f64().unwrap() + rise);
+                }
+            }
+        }
+        talus::scene::from_value(v).unwrap()
+    };
+    let mut pour = quick_pour();
+    pour.skin = Some(0.05);
+    let cases = [
+        (
+            "disks",
+            drop(talus::bench::packing_scene(300), 2.0, 1.0),
+            1500,
+        ),
+        (
+            "12-gons",
+            drop(talus::bench::polygon_pile_scene(120), 0.0, 10.0),
+            1500,
+        ),
+        (
+            "rods",
+            drop(talus::bench::rod_pile_scene(60), 1.0, 10.0),
+            3000,
+        ),
+        ("pour", pour, 6000),
+    ];
+    for (name, scene, steps) in cases {
+        let name = format!("lean_steps_change_no_bit ({name})");
+        let Some(mut lean) = gpu_sim(&name, scene.clone()) else {
+            return;
+        };
+        let mut staged = gpu_sim(&name, scene).unwrap();
+        staged.set_stage_every(1);
+        lean.advance(steps).unwrap();
+        staged.advance(steps).unwrap();
+        let (a, b) = (lean.counters(), staged.counters());
+        eprintln!("{name}: lean {a:?}, every step staged {b:?}");
+        assert!(
+            a.rebuilds > 10,
+            "{name}: the lists were rebuilt ({})",
+            a.rebuilds
+        );
+        assert_eq!(a.rebuilds, b.rebuilds, "{name}: the same rebuilds");
+        assert_eq!(b.pauses, 0, "{name}: a staged step never pauses");
+        assert!(a.pauses > 3, "{name}: lean steps paused ({})", a.pauses);
+        // Fewer commands even here, where the lists are rebuilt every 3 to 10 steps (the
+        // 12-gons: every 3; `talus bench` measures the steady runs between rebuilds).
+        assert!(
+            a.direct + a.indirect < b.direct + b.indirect,
+            "{name}: lean steps record fewer commands"
+        );
+        let (sa, sb) = (lean.device_state(), staged.device_state());
+        assert!(sa == sb, "{name}: the runs differ");
+        assert_eq!(
+            lean.download().contacts,
+            staged.download().contacts,
+            "{name}: the same contacts"
+        );
+    }
+}

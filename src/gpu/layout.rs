@@ -57,6 +57,8 @@ pub mod control {
     pub const AHEAD_REBUILD: u32 = 16;
     /// How many times the device built the lists (`C_REBUILDS`).
     pub const REBUILDS: usize = 7;
+    /// 1 while the step in progress was recorded with the rebuild stages (`C_STAGED`).
+    pub const STAGED: usize = 8;
     /// Inactive particles counted at a rebuild (`C_INACTIVE`).
     pub const INACTIVE: usize = 9;
     pub const BLOCKED: usize = 10;
@@ -65,6 +67,9 @@ pub mod control {
     pub const HALT_CONTACTS_FULL: u32 = 4;
     pub const HALT_TABLE_FULL: u32 = 8;
     pub const HALT_TOO_FAST: u32 = 16;
+    /// Not a failure: a lean step paused until the next step with the rebuild stages
+    /// (`HALT_PAUSED`; src/gpu/step.rs).
+    pub const HALT_PAUSED: u32 = 32;
 }
 
 #[repr(C)]

@@ -109,6 +109,13 @@ pub struct GpuSimulation {
     dispatches: std::cell::Cell<u64>,
     indirect: std::cell::Cell<u64>,
     submissions: std::cell::Cell<u64>,
+    /// Batches in which a lean step paused for a rebuild (`step::STAGE_EVERY`); how often
+    /// a step carries the rebuild stages now (`step::stage_interval`), unless a test
+    /// forces it (1: every step, the reference); the rebuild count last read back.
+    pauses: u64,
+    stage_every: u64,
+    forced_stage_every: Option<u64>,
+    rebuilds_read: Option<u32>,
     /// The exact device state read by the last `download`: what a checkpoint of `sim`
     /// carries (`checkpoint_state`).
     downloaded: Option<DeviceState>,
@@ -445,6 +452,10 @@ impl GpuSimulation {
             synced: true,
             dispatches: Default::default(),
             submissions: Default::default(),
+            pauses: 0,
+            stage_every: step::STAGE_EVERY,
+            forced_stage_every: None,
+            rebuilds_read: None,
             indirect: Default::default(),
             downloaded: None,
             recorder: Default::default(),

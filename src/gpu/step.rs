@@ -12,12 +12,37 @@ pub const STEPS_PER_SUBMIT: u64 = 64;
 /// submits one while the device runs the other.
 pub const BATCHES_IN_FLIGHT: usize = 2;
 
+/// The first step of every batch and every `STAGE_EVERY`-th after it are recorded with
+/// the rebuild stages (issue 38); the steps between are lean: `contact_forces`, the
+/// integrator (Gear's correction with the next prediction) and `advance_clock`, 3 to 5
+/// commands. A lean step whose survey asks for a rebuild pauses the device
+/// (`HALT_PAUSED`, shaders/contact_forces.wgsl) until the next step with the stages,
+/// which rebuilds from the paused state and goes on: the same steps to the bit as if
+/// every step carried the stages, with at most `STAGE_EVERY − 1` recorded steps run as
+/// no-ops per rebuild (the host submits as many more). Every 16th: 15 empty dispatches
+/// spread over 16 steps, about one command per step. Where the lists are rebuilt more
+/// often, the stages come more often (`stage_interval`).
+pub const STAGE_EVERY: u64 = 16;
+
+/// How often the next batch records the rebuild stages, from the last batch read back:
+/// `steps` run and `rebuilds` among them. Half the steps between rebuilds, so that a
+/// pause loses about a quarter of them: lean steps cost ~5 commands where a staged one
+/// costs ~20, so they pay down to rebuilds every ~4 steps, where this gives 1 (every
+/// step staged, nothing lost).
+pub(super) fn stage_interval(steps: u64, rebuilds: u64) -> u64 {
+    if rebuilds == 0 {
+        return STAGE_EVERY;
+    }
+    (steps / (2 * rebuilds)).clamp(1, STAGE_EVERY)
+}
+
 /// A submitted batch of steps: its submission and the staging buffer its control words
 /// are copied to.
 pub(super) struct Batch {
     pub(super) staging: wgpu::Buffer,
     pub(super) index: wgpu::SubmissionIndex,
-    pub(super) steps: u64,
+    /// The step the device reaches at its end if no lean step pauses.
+    pub(super) end: u64,
     /// Its readback's mapping outcome.
     pub(super) mapped: super::transfer::MapFlag,
 }
@@ -57,6 +82,8 @@ pub(super) struct StepKind {
     pub(super) predicted: bool,
     /// Gear: predict the next step at the end of this one.
     pub(super) ahead: bool,
+    /// Recorded with the rebuild stages (`STAGE_EVERY`); a lean step without them.
+    pub(super) staged: bool,
 }
 
 /// One indirect dispatch's arguments in `dispatch_args`: x, y, z and a word of padding.
@@ -110,6 +137,9 @@ pub struct Counters {
     /// Rebuilds of the neighbour lists (each runs the `REBUILD_STAGES.len()` indirect
     /// dispatches of its step).
     pub rebuilds: u64,
+    /// Batches in which a lean step paused for a rebuild (`STAGE_EVERY`): their steps
+    /// after the pause ran as no-ops and were submitted again.
+    pub pauses: u64,
 }
 
 impl GpuSimulation {
@@ -121,7 +151,14 @@ impl GpuSimulation {
             indirect: self.indirect.get(),
             submissions: self.submissions.get(),
             rebuilds: self.rebuilds(),
+            pauses: self.pauses,
         }
+    }
+
+    /// Records the rebuild stages in every `k`-th step of a batch, whatever the rebuilds
+    /// (`STAGE_EVERY`; 1: in every step, as before issue 38). Tests compare the two.
+    pub fn set_stage_every(&mut self, k: u64) {
+        self.forced_stage_every = Some(k.max(1));
     }
 
     pub(super) fn dispatch(&self, pass: &mut wgpu::ComputePass, k: Kernel, groups: u64) {
@@ -184,8 +221,14 @@ impl GpuSimulation {
         self.synced = false;
     }
 
-    /// Runs some kernels once, in order, in one submission (tests of single stages).
+    /// Runs some kernels once, in order, in one submission (tests of single stages), as
+    /// in a step recorded with the rebuild stages (`STAGE_EVERY`): nothing pauses.
     pub fn run_kernels(&mut self, ks: &[Kernel]) {
+        self.gpu.queue.write_buffer(
+            &self.buffers.control,
+            (control::STAGED * 4) as u64,
+            bytemuck::bytes_of(&1u32),
+        );
         let mut enc = self.gpu.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&Default::default());
@@ -227,11 +270,14 @@ impl GpuSimulation {
         } else if !how.predicted {
             self.encode_kernel(pass, Kernel::Predict);
         }
-        // Between rebuilds the rebuild stages are dispatched with no workgroups (issue 14
-        // item 2): `plan_rebuild` writes their arguments once the survey has decided.
-        self.encode_kernel(pass, Kernel::PlanRebuild);
-        for stage in 0..REBUILD_STAGES.len() {
-            self.dispatch_rebuild_stage(pass, stage);
+        // In a staged step the rebuild stages are dispatched with no workgroups between
+        // rebuilds (issue 14 item 2): `plan_rebuild` writes their arguments once the
+        // survey has decided. A lean step records none (`STAGE_EVERY`).
+        if how.staged {
+            self.encode_kernel(pass, Kernel::PlanRebuild);
+            for stage in 0..REBUILD_STAGES.len() {
+                self.dispatch_rebuild_stage(pass, stage);
+            }
         }
         self.encode_kernel(
             pass,
@@ -266,22 +312,27 @@ impl GpuSimulation {
     /// the device always has work queued and the host never waits on an idle device. A
     /// halt stops every later kernel on the device at once (each returns when `halted`),
     /// so a batch submitted after the halting one changes nothing, and the halt still
-    /// names its step.
+    /// names its step. A pause (`STAGE_EVERY`) is not a halt: the device went fewer
+    /// steps than were recorded, read from its step counter, and the host submits the
+    /// rest.
     pub fn advance(&mut self, steps: u64) -> Result<(), Divergence> {
         let sources_left = self.sources_left();
         // Gear's prediction runs ahead at the end of the step before (`CorrectAhead`, as
         // the CPU path's `correct_ahead`) when the device goes on at once: not across an
         // insertion (new particles are predicted in their step), nor into a stop (the end
-        // of the advance, a layered row: the host reads a corrected state).
+        // of the advance, a layered row: the host reads a corrected state). A paused
+        // state is predicted and surveyed; the step that lifts the pause predicts nothing
+        // more (its `predict` returns while paused).
         let can_run_ahead = self.params.integrator == 0 && !sources_left;
+        let target = self.step + steps;
         let mut predicted = false;
-        let mut left = steps;
         let mut in_flight: std::collections::VecDeque<Batch> = Default::default();
-        // The step the device reaches once the batches in flight are done.
+        // The step the device reaches once the batches in flight are done, if none
+        // pauses.
         let mut planned = self.step;
-        while left > 0 || !in_flight.is_empty() {
-            if left > 0 && in_flight.len() < BATCHES_IN_FLIGHT {
-                let mut k = left.min(STEPS_PER_SUBMIT);
+        loop {
+            if planned < target && in_flight.len() < BATCHES_IN_FLIGHT {
+                let mut k = (target - planned).min(STEPS_PER_SUBMIT);
                 // Submissions stop where a layered row is due; the host lays it once the
                 // device has caught up.
                 match self.next_layered_step(planned) {
@@ -295,23 +346,25 @@ impl GpuSimulation {
                     None => {}
                 }
                 if k > 0 {
-                    let last = k == left;
+                    let last = planned + k == target;
                     let stops = last || self.next_layered_step(planned + k) == Some(planned + k);
                     let how = StepKind {
                         sources_left,
                         record: false,
                         predicted,
                         ahead: can_run_ahead,
+                        staged: true,
                     };
-                    in_flight.push_back(self.submit_batch(k, how, last, stops));
+                    in_flight.push_back(self.submit_batch(k, planned + k, how, last, stops));
                     predicted = can_run_ahead && !stops;
                     planned += k;
-                    left -= k;
                     continue;
                 }
             }
-            let batch = in_flight.pop_front().expect("a batch in flight");
-            let done = batch.steps;
+            let Some(batch) = in_flight.pop_front() else {
+                break;
+            };
+            let end = batch.end;
             let c = self.wait_for(batch);
             if let Some(e) = self.failure() {
                 in_flight.clear();
@@ -319,25 +372,43 @@ impl GpuSimulation {
             }
             self.live = c[control::LIVE];
             self.lost_now = c[control::LOST] as u64;
-            if c[control::HALT] != 0 {
+            if c[control::HALT] & !control::HALT_PAUSED != 0 {
                 // The later batches ran as no-ops; let them finish first.
                 for b in in_flight.drain(..) {
                     self.wait_for(b);
                 }
                 return Err(self.halt_cause(&c));
             }
-            self.step += done;
+            // The device's step counter (32 bits) against the batch's planned end: the
+            // steps it did not run (a pause and the no-ops after it) are submitted again.
+            let behind = (end as u32).wrapping_sub(c[control::STEP]) as u64;
+            if behind > 0 {
+                self.pauses += 1;
+                planned -= behind;
+                for b in &mut in_flight {
+                    b.end -= behind;
+                }
+            }
+            let rebuilds = c[control::REBUILDS];
+            if let Some(before) = self.rebuilds_read {
+                let ran = end - behind - self.step;
+                self.stage_every = stage_interval(ran, rebuilds.wrapping_sub(before) as u64);
+            }
+            self.rebuilds_read = Some(rebuilds);
+            self.step = end - behind;
         }
         Ok(())
     }
 
-    /// Encodes and submits `k` steps, with a copy of the control words at their end.
-    /// `how`: its first step (and whether steps may predict ahead); `last`: the batch
-    /// ends the `advance`, its last step records the contacts; `stops`: the device stops
-    /// after it (the end, a layered row), its last step does not predict ahead.
+    /// Encodes and submits `k` steps, with a copy of the control words at their end;
+    /// `end`: the step the device reaches if none pauses. `how`: its first step (and
+    /// whether steps may predict ahead); `last`: the batch ends the `advance`, its last
+    /// step records the contacts; `stops`: the device stops after it (the end, a layered
+    /// row), its last step does not predict ahead.
     pub(super) fn submit_batch(
         &mut self,
         k: u64,
+        end: u64,
         first: StepKind,
         last: bool,
         stops: bool,
@@ -354,11 +425,15 @@ impl GpuSimulation {
             let mut pass = enc.begin_compute_pass(&Default::default());
             self.mark_start(&mut pass);
             let mut how = first;
+            // Profiled steps carry the stages (their timestamps must fit one query set).
+            let profiling = self.recorder.borrow().is_some();
+            let every = self.forced_stage_every.unwrap_or(self.stage_every);
             for step in 1..=k {
                 let end = step == k;
                 let ahead = first.ahead && !(end && stops);
                 how.record = last && end;
                 how.ahead = ahead;
+                how.staged = profiling || (step - 1) % every == 0;
                 self.encode_step(&mut pass, how);
                 how.predicted = ahead;
             }
@@ -375,7 +450,7 @@ impl GpuSimulation {
         Batch {
             staging,
             index,
-            steps: k,
+            end,
             mapped,
         }
     }
