@@ -22,8 +22,8 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use talus::gpu::GpuSimulation;
 use talus::gpu::device::{self, BackendChoice as Backend};
+use talus::gpu::{GpuError, GpuSimulation};
 use talus::run::Engine;
 use talus::{bench, checkpoint, run, scene, sim::Simulation};
 
@@ -79,9 +79,10 @@ enum Command {
         /// GPU when there is one; --backend gpu takes any adapter).
         #[arg(long)]
         estimate: bool,
-        /// The backends --estimate times (auto: the CPU path and a hardware GPU).
-        #[arg(long, value_enum, default_value_t = Backend::Auto, requires = "estimate")]
-        backend: Backend,
+        /// The backends --estimate times (auto, the default: the CPU path and a hardware
+        /// GPU). gpu also says whether the scene fits the adapter a run would take.
+        #[arg(long, value_enum)]
+        backend: Option<Backend>,
     },
     /// Print the built-in default scene.
     DefaultScene,
@@ -294,7 +295,7 @@ fn command(command: Command, threads: usize) -> ExitCode {
             overrides,
             estimate,
             backend,
-        } => cmd_check(scene, overrides, estimate.then_some(backend)),
+        } => cmd_check(scene, overrides, estimate, backend),
         Command::DefaultScene => {
             out!("{}", scene::DEFAULT_SCENE.trim_end());
             Ok(())
@@ -863,7 +864,8 @@ fn finish_reproduction(
 fn cmd_check(
     path: Option<PathBuf>,
     overrides: Vec<String>,
-    estimate: Option<Backend>,
+    estimate: bool,
+    backend: Option<Backend>,
 ) -> Result<(), Failure> {
     let sim = build_simulation(&path, &overrides)?;
     out!(
@@ -886,10 +888,50 @@ fn cmd_check(
     for line in lines {
         out!("{line}");
     }
-    if let Some(backend) = estimate {
-        estimate_run_time(sim, backend)?;
+    if backend == Some(Backend::Gpu) {
+        check_gpu_fit(&sim)?;
+    }
+    if estimate {
+        estimate_run_time(sim, backend.unwrap_or(Backend::Auto))?;
     }
     Ok(())
+}
+
+/// `talus check --backend gpu`: whether the scene fits the adapter a GPU run would take,
+/// with everything its sources and layered rows will add (`gpu::footprint`), before a
+/// run finds out at its upload.
+fn check_gpu_fit(sim: &Simulation) -> Result<(), Failure> {
+    if let Some(reason) = talus::gpu::unsupported(sim) {
+        return Err(Failure::failed(format!(
+            "--backend gpu: {reason}; use --backend cpu"
+        )));
+    }
+    let adapter = device::choose_adapter().map_err(GpuError::from)?;
+    let name = adapter.get_info().name;
+    let binding = device::binding_limit(&adapter.limits());
+    let needs = talus::gpu::footprint(sim);
+    let (what, bytes) = needs.buffers[0];
+    let mib = |b: u64| b as f64 / (1u64 << 20) as f64;
+    out!(
+        "GPU path on {name}: {} particles at most (those there are and those to come), {} \
+         candidates each, a {} × {} cell grid; the largest buffer, {what}, takes {:.1} MiB \
+         of the {:.0} MiB one binding holds",
+        needs.particles,
+        needs.list_cap,
+        needs.grid[0],
+        needs.grid[1],
+        mib(bytes),
+        mib(binding)
+    );
+    match needs.misfit(binding) {
+        None => {
+            out!("the scene fits {name}");
+            Ok(())
+        }
+        Some(why) => Err(Failure::failed(format!(
+            "the scene does not fit {name}: {why}; use --backend cpu"
+        ))),
+    }
 }
 
 /// `talus check --estimate`: the expected work of the run, and the time it takes on each

@@ -1044,3 +1044,45 @@ fn check_estimates_the_run_time() {
         "{line}"
     );
 }
+
+/// `talus check --backend gpu` says whether the scene fits the adapter a GPU run would
+/// take, counting the particles its sources will add (issue 38 item 3): the 50 000-grain
+/// heap fits any adapter talus runs on; 5·10⁶ grains need more workgroups in one
+/// dispatch than the GPU path issues, on every adapter, and the check fails saying so.
+#[test]
+fn check_says_whether_a_scene_fits_the_gpu() {
+    let heap = "scenes/heap_50k.json";
+    let (code, out, err) = talus(&["check", heap, "--backend", "gpu"]);
+    if err.contains("no GPU adapter found") {
+        assert!(
+            !talus::gpu::device::gpu_required(),
+            "TALUS_REQUIRE_GPU=1 but no adapter"
+        );
+        eprintln!("SKIPPED check --backend gpu: no adapter");
+        assert_eq!(code, 1);
+        return;
+    }
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("GPU path on ") && out.contains("50000 particles at most"),
+        "{out}"
+    );
+    assert!(out.contains("the scene fits"), "{out}");
+    let (code, out, err) = talus(&[
+        "check",
+        heap,
+        "--backend",
+        "gpu",
+        "--set",
+        "particles[0].count=5000000",
+        "--set",
+        "limits.max_particles=1e7",
+    ]);
+    assert_eq!(code, 1, "{out}{err}");
+    assert!(out.contains("5000000 particles at most"), "{out}");
+    assert!(
+        err.contains("does not fit") && err.contains("workgroups") && err.contains("--backend cpu"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+}

@@ -1018,3 +1018,34 @@ fn lean_steps_change_no_bit() {
         );
     }
 }
+
+#[test]
+fn the_footprint_counts_what_the_upload_holds() {
+    // Issue 38 item 3: `talus check --backend gpu` and the upload's checks size the
+    // buffers from `gpu::footprint` before any candidate is drawn; the upload then
+    // holds exactly that many particles: a pour (its sources' particles to come), a
+    // layered pile (its rows at their most), rods (their longer lists).
+    let cases = [
+        ("pour", quick_pour()),
+        ("layered", layered_pile(true)),
+        ("rods", scene_file("r9_rods_reduced.json", &[])),
+    ];
+    for (name, scene) in cases {
+        let name = format!("the_footprint_counts_what_the_upload_holds ({name})");
+        let sim = Simulation::new(scene.clone()).unwrap();
+        let needs = talus::gpu::footprint(&sim);
+        let Some(g) = gpu_sim(&name, scene) else {
+            return;
+        };
+        assert_eq!(needs.particles, g.capacity(), "{name}");
+        assert!(
+            needs.particles > sim.particles.len() as u64 || name.contains("rods"),
+            "{name}: particles to come"
+        );
+        assert_eq!(
+            needs.list_cap > 16,
+            name.contains("rods"),
+            "{name}: {needs:?}"
+        );
+    }
+}

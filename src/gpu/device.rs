@@ -236,12 +236,14 @@ impl Gpu {
             .clone()
     }
 
+    /// The most bytes one buffer may hold and be bound.
+    pub fn binding_limit(&self) -> u64 {
+        binding_limit(&self.limits)
+    }
+
     /// Checks a buffer of `bytes` against the device limits before allocating it.
     pub fn check_buffer(&self, what: &str, bytes: u64) -> Result<(), DeviceError> {
-        let max = self
-            .limits
-            .max_storage_buffer_binding_size
-            .min(self.limits.max_buffer_size);
+        let max = self.binding_limit();
         if bytes > max {
             return Err(DeviceError::TooLarge {
                 name: self.info.name.clone(),
@@ -252,6 +254,13 @@ impl Gpu {
         }
         Ok(())
     }
+}
+
+/// The most bytes one buffer may hold and be bound under `limits`.
+pub fn binding_limit(limits: &wgpu::Limits) -> u64 {
+    limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
 }
 
 /// Whether tests must fail, rather than skip, when no adapter exists (CI sets it).
@@ -293,11 +302,14 @@ pub fn describe() -> String {
                 "; no timestamps inside passes (`talus bench --kernels` unavailable)"
             }
         );
-        let binding = l.max_storage_buffer_binding_size.min(l.max_buffer_size);
+        let binding = binding_limit(&l);
+        let largest: Vec<String> = (crate::gpu::footprint::largest_scenes(binding).iter())
+            .map(|(what, n)| format!("{n} {what}"))
+            .collect();
         let _ = writeln!(
             s,
-            "      largest scene the GPU path holds here: {} particles",
-            crate::gpu::max_particles(binding)
+            "      largest scene the GPU path holds here: {}",
+            largest.join(", ")
         );
         if let Some(why) = unsuitable(a) {
             let _ = writeln!(s, "      unsuitable: {why}");

@@ -26,7 +26,9 @@
 pub mod bindings;
 mod buckets;
 mod buffers;
+pub mod footprint;
 pub use bindings::{BINDINGS, Binding};
+pub use footprint::{Footprint, footprint, max_particles};
 pub mod device;
 mod insert;
 pub mod kernels;
@@ -152,48 +154,6 @@ pub enum GpuError {
 /// hold one element of the largest struct the shaders bind.
 pub const MIN_BUFFER: u64 = 256;
 
-/// The largest buffers that grow with the particle count n, and their sizes in bytes:
-/// what an adapter's binding limit must hold (checked before a run).
-pub fn particle_buffers(n: u64) -> [(&'static str, u64); 3] {
-    particle_buffers_with(n, MAX_CONTACTS)
-}
-
-/// `particle_buffers` with `cap` candidates per particle (`list_capacity`); a
-/// spheropolygon scene's springs take 32 bytes a candidate more (`sub_hist`), counted in
-/// `resume_with_gpu`.
-pub fn particle_buffers_with(n: u64, cap: u32) -> [(&'static str, u64); 3] {
-    let table_cap = table_capacity(n);
-    [
-        ("particle state", n * size_of::<State>() as u64),
-        ("contact", n * cap as u64 * 16),
-        ("spring table", table_cap * size_of::<Entry>() as u64),
-    ]
-}
-
-/// Slots of the spring table for n particles: a power of two (the hash's mask), about
-/// eight per particle (a dense packing has ~2 contacts per particle as the lower id: the
-/// table stays about a quarter full, and probes stay short).
-fn table_capacity(n: u64) -> u64 {
-    (8 * n).next_power_of_two().max(64)
-}
-
-/// The most particles the GPU path holds where a buffer binds at most `binding` bytes:
-/// every buffer of `particle_buffers` within it, and one thread per particle in a
-/// dispatch of at most `MAX_WORKGROUPS` workgroups (`talus info` prints it).
-pub fn max_particles(binding: u64) -> u64 {
-    let fits = |n: u64| particle_buffers(n).iter().all(|&(_, b)| b <= binding);
-    let (mut lo, mut hi) = (0, MAX_WORKGROUPS * WG as u64);
-    if fits(hi) {
-        return hi;
-    }
-    // fits(lo) and not fits(hi): the sizes grow with n.
-    while hi - lo > 1 {
-        let mid = lo + (hi - lo) / 2;
-        if fits(mid) { lo = mid } else { hi = mid }
-    }
-    lo
-}
-
 /// Candidates per particle the lists hold (`Params::list_cap`): `MAX_CONTACTS` (16)
 /// for disks and polygons, whose circumscribed circles hold few neighbours; for long
 /// rods, whose circles (d widths across) each meet ~d others, twice the number expected
@@ -227,6 +187,35 @@ pub fn list_capacity(sim: &Simulation) -> u32 {
     let expected = 0.5 * std::f64::consts::PI * reach * reach * 0.9 / area;
     let cap = (2.0 * expected + 8.0).min(1024.0) as u32;
     cap.next_multiple_of(16).max(MAX_CONTACTS)
+}
+
+/// What the GPU path cannot take of a scene, or `None` (checked at the upload and by
+/// `talus check --backend gpu`).
+pub fn unsupported(sim: &Simulation) -> Option<String> {
+    if let Some(reason) = unsupported_spheropolygons(sim) {
+        return Some(reason);
+    }
+    // Props.flags holds material and copy in 12 bits each.
+    let field = 1usize << (layout::COPY_SHIFT - layout::MATERIAL_SHIFT);
+    if sim.scene.materials.len() > field || sim.scene.replicas as usize > field {
+        return Some(format!(
+            "the GPU path holds at most {field} materials and {field} copies of a scene"
+        ));
+    }
+    if params::gpu_pair_side(&sim.law).is_none() {
+        return Some(format!(
+            "the GPU path holds contact.pairs for at most {} materials (and the walls); the scene has {}",
+            layout::MAX_PAIR_SLOTS.isqrt() - 1,
+            sim.scene.materials.len()
+        ));
+    }
+    let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);
+    if !point_sources.is_empty() && !layered_specs.is_empty() {
+        return Some(
+            "point sources together with layer-by-layer blocks are not on the GPU path yet".into(),
+        );
+    }
+    None
 }
 
 /// What the GPU path cannot take of a spheropolygon scene (law hertz_cohesive): cores
@@ -292,46 +281,24 @@ impl GpuSimulation {
             sim,
             device: device_state,
         } = ckpt;
-        if let Some(reason) = unsupported_spheropolygons(&sim) {
+        if let Some(reason) = unsupported(&sim) {
             return Err(GpuError::Unsupported(reason));
         }
-        // Props.flags holds material and copy in 12 bits each.
-        let field = 1usize << (layout::COPY_SHIFT - layout::MATERIAL_SHIFT);
-        if sim.scene.materials.len() > field || sim.scene.replicas as usize > field {
-            return Err(GpuError::Unsupported(format!(
-                "the GPU path holds at most {field} materials and {field} copies of a scene"
-            )));
-        }
-        if params::gpu_pair_side(&sim.law).is_none() {
-            return Err(GpuError::Unsupported(format!(
-                "the GPU path holds contact.pairs for at most {} materials (and the walls); the scene has {}",
-                layout::MAX_PAIR_SLOTS.isqrt() - 1,
-                sim.scene.materials.len()
-            )));
-        }
-        let (point_sources, layered_specs) = crate::sim::creators(&sim.scene);
-        if !point_sources.is_empty() && !layered_specs.is_empty() {
-            return Err(GpuError::Unsupported(
-                "point sources together with layer-by-layer blocks are not on the GPU path yet"
-                    .into(),
-            ));
-        }
+        let (_, layered_specs) = crate::sim::creators(&sim.scene);
         // Cells hold every candidate within range + skin of the lists (issue 13): the
         // law's grid with its cells doubled (the fixed-point unit scales by a power of
         // two; any other size loses the lattice piles' exact alignment, see
         // tests/gpu_scenes.rs `lattice_pile_agrees_with_the_cpu`).
         let skin = sim.skin();
         let grid = sim.grid.coarsened(sim.grid.cell_size + skin);
-        if grid.nx >= MAX_CELLS_PER_SIDE || grid.nz >= MAX_CELLS_PER_SIDE {
+        // Every particle the point sources will still insert is drawn below, on the
+        // host, and every buffer is sized for them: check that they and the grid fit the
+        // adapter first (a count of 4·10⁹ would otherwise abort on allocation; issue 16).
+        let needs = footprint(&sim);
+        if let Some(reason) = needs.misfit(gpu.binding_limit()) {
             return Err(DeviceError::TooLarge {
                 name: gpu.info.name.clone(),
-                reason: format!(
-                    "the cell grid has {} × {} cells, the GPU path handles at most {} per \
-                     side; make the domain smaller",
-                    grid.nx,
-                    grid.nz,
-                    MAX_CELLS_PER_SIDE - 1
-                ),
+                reason,
             }
             .into());
         }
@@ -342,25 +309,10 @@ impl GpuSimulation {
         }
         let origin = grid.origin;
 
-        // Every particle the point sources will still insert is drawn now, on the host:
-        // check that they fit the adapter before drawing them (a count of 4·10⁹ would
-        // otherwise abort on allocation; issue 16).
-        // (Every copy of the scene has its sources, copy after copy.)
-        let to_come: u64 = (point_sources.iter().cycle().zip(&sim.sources))
-            .map(|(s, st)| s.count.saturating_sub(st.inserted) as u64)
-            .sum();
-        gpu.check_buffer(
-            "source candidate",
-            to_come.saturating_mul(size_of::<Candidate>() as u64),
-        )?;
-        gpu.check_buffer(
-            "particle state",
-            (to_come + sim.particles.len() as u64).saturating_mul(size_of::<State>() as u64),
-        )?;
         let up = insert::upcoming(&sim, &layered_specs, origin, cell_size);
         let n_now = sim.particles.len() as u32;
         let n_cap = (n_now + up.candidates.len() as u32 + up.layered_count).max(1);
-        let table_cap = table_capacity(n_cap as u64);
+        let table_cap = footprint::table_capacity(n_cap as u64);
         let cells = bucket_count(&grid, n_cap);
 
         let params =
@@ -368,30 +320,22 @@ impl GpuSimulation {
         let blocks1 = params.scan_blocks1;
         // Every dispatch is one-dimensional: at most 65535 workgroups. The clears of the
         // cells and of the spring table loop over what one dispatch does not cover; the
-        // per-particle stages take one thread per particle.
-        let widest = [ceil_div(n_cap as u64, WG as u64), blocks1 as u64];
-        let most = widest.into_iter().max().unwrap_or(0);
-        if most > MAX_WORKGROUPS {
+        // per-particle stages take one thread per particle (`Footprint::misfit`).
+        debug_assert_eq!(
+            needs.particles, n_cap as u64,
+            "the footprint counts the upload"
+        );
+        if blocks1 as u64 > MAX_WORKGROUPS {
             return Err(DeviceError::TooLarge {
                 name: gpu.info.name.clone(),
                 reason: format!(
-                    "{n_cap} particles need {most} workgroups in one dispatch and the GPU \
-                     path issues at most {MAX_WORKGROUPS} (about 4.19 million particles); \
-                     use --backend cpu"
+                    "the prefix sum over {cells} cells needs {blocks1} workgroups and the GPU \
+                     path issues at most {MAX_WORKGROUPS}; make the domain smaller"
                 ),
             }
             .into());
         }
-
-        let list_cap = params.list_cap;
-        for (what, bytes) in particle_buffers_with(n_cap as u64, list_cap) {
-            gpu.check_buffer(what, bytes)?;
-        }
-        if matches!(sim.law, ContactLaw::HertzCohesive(_)) {
-            let sub = n_cap as u64 * list_cap as u64 * size_of::<SubSprings>() as u64;
-            gpu.check_buffer("sub-contact spring", sub)?;
-        }
-        gpu.check_buffer("cell", cells * 4)?;
+        debug_assert_eq!(needs.list_cap, params.list_cap);
         let walls = device_walls(&sim.walls, origin, cell_size);
 
         let control = initial_control(sim.step, n_now, up.sources.len());
@@ -502,21 +446,12 @@ mod tests {
         // lavapipe binds 128 MiB: the candidates' result arrays (256 B per particle)
         // and the spring table (16 B per slot, a power of two) stop at 2^19.
         let lavapipe = 128 << 20;
-        assert_eq!(max_particles(lavapipe), 1 << 19);
-        assert!(
-            particle_buffers(1 << 19)
-                .iter()
-                .all(|&(_, b)| b <= lavapipe)
-        );
-        assert!(
-            particle_buffers((1 << 19) + 1)
-                .iter()
-                .any(|&(_, b)| b > lavapipe)
-        );
+        assert_eq!(max_particles(lavapipe, MAX_CONTACTS, false), 1 << 19);
         // NVIDIA-class 2 GiB bindings: one dispatch of 65 535 workgroups of 64 is the
         // limit, above the 4·10⁶ disks issue 14 asks for.
-        assert_eq!(max_particles(2 << 30), MAX_WORKGROUPS * WG as u64);
-        assert!(max_particles(2 << 30) >= 4_000_000);
+        let nvidia = max_particles(2 << 30, MAX_CONTACTS, false);
+        assert_eq!(nvidia, MAX_WORKGROUPS * WG as u64);
+        assert!(nvidia >= 4_000_000);
     }
 
     #[test]

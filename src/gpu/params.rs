@@ -175,7 +175,7 @@ pub(super) fn step_params(
         cells: cells as u32,
         n_walls: sim.walls.len() as u32,
         n_sources: n_sources as u32,
-        table_mask: (table_capacity(n_cap as u64) - 1) as u32,
+        table_mask: (super::footprint::table_capacity(n_cap as u64) - 1) as u32,
         integrator: match sim.scene.integrator {
             IntegratorKind::Gear5 => 0,
             IntegratorKind::Leapfrog => 1,

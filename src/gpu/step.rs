@@ -155,6 +155,12 @@ impl GpuSimulation {
         }
     }
 
+    /// The particles the device holds: those there are and every one still to come
+    /// (what `footprint` counts before the upload).
+    pub fn capacity(&self) -> u64 {
+        self.n_cap as u64
+    }
+
     /// Records the rebuild stages in every `k`-th step of a batch, whatever the rebuilds
     /// (`STAGE_EVERY`; 1: in every step, as before issue 38). Tests compare the two.
     pub fn set_stage_every(&mut self, k: u64) {
