@@ -63,6 +63,9 @@ const HALT_TOO_FAST: u32 = 16u;
 // lifts the pause and rebuilds from the paused, predicted state: the run goes on as if
 // the stages had been recorded in the paused step (bitwise the same).
 const HALT_PAUSED: u32 = 32u;
+// Params.reading bits (src/gpu/layout.rs).
+const READING_SLIP_DAMPING: u32 = 1u;
+const READING_CONTACT_ARM: u32 = 2u;
 // Candidates of one source looked at per step.
 const INSERT_WINDOW: u32 = 4u;
 
@@ -135,7 +138,10 @@ struct Params {
     // of the contact's effective mass when per_mass is 1.
     pair_side: u32,
     per_mass: u32,
-    pad_pair0: u32,
+    // The continuous law's readings of paper 001 (src/law/continuous.rs `Reading`):
+    // READING_SLIP_DAMPING | READING_CONTACT_ARM, 0 for the paper's text; its clamp
+    // is `clamp`.
+    reading: u32,
     pad_pair1: u32,
     pad_pair2: u32,
     pair_law: array<vec4<f32>, 128>,

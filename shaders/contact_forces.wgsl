@@ -153,8 +153,12 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
         m_eff = effective_mass(i, j, wall, m1);
         pair = pair_slot(i, j, wall);
     }
+    // The centres' velocity and the spins, for the continuous law's readings (v2 of a
+    // wall is zero).
+    let v_centres = dot(v1.xy - v2.xy, t);
     let input = ContactInput(g.delta, g.r, g.sigma, -dot(v12, g.n) * rate, dot(v12, t),
-                             m12, mass, hist_in[slot], params.dt, m_eff, pair);
+                             m12, mass, hist_in[slot], params.dt, m_eff, pair,
+                             v_centres, v1.z + v2.z);
     let res = evaluate(input);
     let f = res.f_n * g.n + res.f_t * t;
     contact_ft[slot] = vec4<f32>(f, cross2(l1, f), -cross2(l2, f));

@@ -16,6 +16,10 @@ struct ContactInput {
     // (src/law/restitution.rs); the other laws ignore them.
     m_eff: f32,
     pair: u32,
+    // The continuous law's other readings of v_t (paper 001 eq. 4, 6): the centres'
+    // relative velocity along t and the sum of the spins; the other laws ignore them.
+    v_centres: f32,
+    spin: f32,
 };
 
 struct ContactOutput {
@@ -140,17 +144,24 @@ fn continuous(c: ContactInput) -> ContactOutput {
     let m = c.mass;
     let f_e = continuous_force(m, c.sigma, c.r, c.delta);
     let k = continuous_stiffness(m, c.sigma, c.r);
-    let c_n = params.damping_fraction * 2.0 * sqrt(m * k);       // eq. 3
-    let f_n = max(f_e + c_n * c.delta_dot, 0.0);
+    let c_n = params.damping_fraction * 2.0 * sqrt(m * k);       // eq. 3, no clamp
+    var f_n = f_e + c_n * c.delta_dot;
+    if (params.clamp != 0u) { f_n = max(f_n, 0.0); }
     let delta_n = max(params.r0 * c.sigma - c.r, 0.0);
     let delta_max = params.alpha * params.mu * delta_n;
-    let delta_f = clamp(c.history + c.v_t * c.dt, -delta_max, delta_max);  // eq. 6
+    // Eq. 6: the spins on the centre distance as written, or the surfaces' slip.
+    var slip = c.v_centres - c.spin * c.r;
+    if ((params.reading & READING_CONTACT_ARM) != 0u) { slip = c.v_t; }
+    let delta_f = clamp(c.history + slip * c.dt, -delta_max, delta_max);
     let mu_f_e = params.mu * f_e;
     let spring = tapered_friction(delta_f, delta_max, mu_f_e);
     let k_t = tapered_stiffness(delta_f, delta_max, mu_f_e);
     let c_t = params.damping_fraction * 2.0 * sqrt(m * k_t);     // eq. 8
-    var f_t = -spring * sign(delta_f) - c_t * c.v_t;
-    if (delta_f == 0.0) { f_t = -c_t * c.v_t; }
+    // Eq. 4: on the centres' velocity as written, or on the surfaces' slip.
+    var v_damped = c.v_centres;
+    if ((params.reading & READING_SLIP_DAMPING) != 0u) { v_damped = c.v_t; }
+    var f_t = -spring * sign(delta_f) - c_t * v_damped;
+    if (delta_f == 0.0) { f_t = -c_t * v_damped; }
     let energy = continuous_energy(m, c.sigma, c.r, c.delta) + tapered_energy(delta_f, delta_max, mu_f_e);
     return ContactOutput(f_n, f_t, delta_f, energy);
 }

@@ -380,7 +380,7 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
             if (old.key[m] == key) { history = old.xi[m]; }
         }
         let input = ContactInput(subs.delta[k] * u, 0.0, 0.0, -dot(v12, n), dot(v12, t),
-                                 m12, mass, history, params.dt, m12, 0u);
+                                 m12, mass, history, params.dt, m12, 0u, 0.0, 0.0);
         let r = evaluate(input);
         let fk = r.f_n * n + r.f_t * t;
         f += fk;

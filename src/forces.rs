@@ -697,6 +697,16 @@ fn disk_kinematics(
     let (v2, m2) = material_velocity(s, pair, g.arm, d);
     let v12 = [v1[0] + s1[0] - v2[0], v1[1] + s1[1] - v2[1]];
     let t = tangent(g.n);
+    // The centres' relative velocity and the spins, for the continuous law's readings
+    // of paper 001 eq. 4 and 6 (a wall neither moves nor spins).
+    let (vc2, w2) = match (pair.is_wall(), d) {
+        (false, Some(_)) => {
+            let v = s.velocity[pair.j as usize];
+            ([v[0], v[1]], v[2])
+        }
+        _ => ([0.0, 0.0], 0.0),
+    };
+    let v_centres = (v1[0] - vc2[0]) * t[0] + (v1[1] - vc2[1]) * t[1];
     let m1 = s.particles.mass[i];
     let (m12, mass) = if m2.is_infinite() {
         (m1, m1)
@@ -711,6 +721,8 @@ fn disk_kinematics(
         sigma: g.sigma,
         delta_dot: -(v12[0] * g.n[0] + v12[1] * g.n[1]),
         v_t: v12[0] * t[0] + v12[1] * t[1],
+        v_centres,
+        spin: v1[2] + w2,
         m12,
         mass,
         history,
@@ -857,6 +869,9 @@ fn area_kinematics(
         sigma: 0.0,
         delta_dot: c.chord * v_n * inv_l,
         v_t: v12[0] * t[0] + v12[1] * t[1],
+        // Read by the continuous law only, which takes disks.
+        v_centres: 0.0,
+        spin: 0.0,
         m12,
         mass: 2.0 * m12,
         history,

@@ -55,6 +55,8 @@ fn inputs(n: usize, area: bool, tail: bool, slots: u32, seed: u64) -> Vec<Contac
                 dt: f(1e-4),
                 m_eff: f(rng.range(0.2, 1.0)),
                 pair: (rng.range(0.0, slots as f64) as u32).min(slots - 1),
+                v_centres: f(rng.range(-1.0, 1.0)),
+                spin: f(rng.range(-2.0, 2.0)),
             }
         })
         .collect()
@@ -103,6 +105,30 @@ fn wgsl_laws_match_their_rust_twins() {
             json!({ "law": "hooke_equivalent", "n": 36.0, "r0": 1.2, "mu": 0.5 }),
             1e-5,
         ),
+        // Paper 001's readings (issue 39): each switch away from the text.
+        (
+            "continuous, clamped",
+            json!({ "law": "continuous", "n": 36.0, "r0": 1.2, "mu": 0.5, "clamp": true }),
+            5e-5,
+        ),
+        (
+            "continuous, slip damped",
+            json!({ "law": "continuous", "n": 36.0, "r0": 1.2, "mu": 0.5,
+                    "tangential_damping": "slip" }),
+            5e-5,
+        ),
+        (
+            "continuous, spins on their own arms",
+            json!({ "law": "continuous", "n": 36.0, "r0": 1.2, "mu": 0.5,
+                    "rolling_arm": "contact_point" }),
+            5e-5,
+        ),
+        (
+            "Hooke-equivalent, as talus read it before issue 39",
+            json!({ "law": "hooke_equivalent", "n": 36.0, "r0": 1.2, "mu": 0.5, "clamp": true,
+                    "tangential_damping": "slip", "rolling_arm": "contact_point" }),
+            1e-5,
+        ),
     ];
     for (name, contact, tol) in laws {
         let law = law(contact);
@@ -118,10 +144,11 @@ fn wgsl_laws_match_their_rust_twins() {
                     word([c.delta, c.r, c.sigma, c.delta_dot]),
                     word([c.v_t, c.m12, c.mass, c.history]),
                     {
-                        let mut w = word([c.dt, c.m_eff, 0.0, 0.0]);
+                        let mut w = word([c.dt, c.m_eff, 0.0, c.v_centres]);
                         w[2] = c.pair;
                         w
                     },
+                    word([c.spin, 0.0, 0.0, 0.0]),
                 ]
             })
             .collect();
@@ -129,9 +156,11 @@ fn wgsl_laws_match_their_rust_twins() {
     let a = bitcast<vec4<f32>>(wgsl_arg(k, 0u));
     let b = bitcast<vec4<f32>>(wgsl_arg(k, 1u));
     let c = bitcast<vec4<f32>>(wgsl_arg(k, 2u));
-    let r = evaluate(ContactInput(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, c.y, bitcast<u32>(c.z)));
+    let d = bitcast<vec4<f32>>(wgsl_arg(k, 3u));
+    let r = evaluate(ContactInput(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, c.y,
+                                  bitcast<u32>(c.z), c.w, d.x));
     wgsl_put(k, 0u, bitcast<vec4<u32>>(vec4<f32>(r.f_n, r.f_t, r.history, r.energy)));";
-        let Some(out) = run_wgsl_fn(name, &[COMMON, LAWS], &params, (3, 1), body, &words) else {
+        let Some(out) = run_wgsl_fn(name, &[COMMON, LAWS], &params, (4, 1), body, &words) else {
             return;
         };
         let cpu: Vec<[f64; 4]> = (cases.iter())

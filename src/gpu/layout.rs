@@ -72,6 +72,12 @@ pub mod control {
     pub const HALT_PAUSED: u32 = 32;
 }
 
+/// `Params::reading` bits: the continuous law's tangential damping on the surfaces'
+/// slip (not the centres' velocity), and eq. 6's spins on each disk's own arm (not the
+/// centre distance).
+pub const READING_SLIP_DAMPING: u32 = 1;
+pub const READING_CONTACT_ARM: u32 = 2;
+
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Params {
@@ -131,7 +137,9 @@ pub struct Params {
     /// of the contact's effective mass (the material form) or absolute.
     pub pair_side: u32,
     pub per_mass: u32,
-    pub pad_pair0: u32,
+    /// The continuous law's readings of paper 001 (src/law/continuous.rs `Reading`):
+    /// `READING_SLIP_DAMPING` | `READING_CONTACT_ARM`, 0 for the paper's text.
+    pub reading: u32,
     pub pad_pair1: u32,
     pub pad_pair2: u32,
     /// Slot s = a · pair_side + b of materials a and b (b = pair_side − 1: a wall):
@@ -337,7 +345,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 max_step2,
                 pair_side,
                 per_mass,
-                pad_pair0,
+                reading,
                 pad_pair1,
                 pad_pair2,
                 pair_law

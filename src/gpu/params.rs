@@ -76,6 +76,15 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             p.alpha = c.alpha as f32;
             p.damping_fraction = c.damping_fraction as f32;
             p.g_scale = c.g as f32;
+            use crate::scene::{RollingArm, TangentialDamping};
+            p.clamp = c.reading.clamp as u32;
+            p.reading = match c.reading.damping {
+                TangentialDamping::Centres => 0,
+                TangentialDamping::Slip => layout::READING_SLIP_DAMPING,
+            } | match c.reading.arm {
+                RollingArm::CentreDistance => 0,
+                RollingArm::ContactPoint => layout::READING_CONTACT_ARM,
+            };
         }
     }
 }

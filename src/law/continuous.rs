@@ -7,7 +7,9 @@
 use super::spring_dashpot::{non_negative, positive};
 use super::tangential::{tapered_energy, tapered_friction, tapered_stiffness};
 use super::{ContactInput, ContactOutput, clamp_non_negative};
-use crate::scene::{ContinuousSpec, HookeEquivalentSpec, SceneError};
+use crate::scene::{
+    ContinuousSpec, HookeEquivalentSpec, RollingArm, SceneError, TangentialDamping,
+};
 
 /// The elastic part of the normal force.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -28,6 +30,18 @@ pub struct Continuous {
     pub damping_fraction: f64,
     /// Force scale g.
     pub g: f64,
+    /// How eq. 3, 4 and 6 are read where the text leaves a choice (SPEC 2.2).
+    pub reading: Reading,
+}
+
+/// The readings of paper 001's law that a scene chooses (issue 39); the defaults are
+/// the paper's text taken literally.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Reading {
+    /// f_n ≥ 0 after the damping (not in eq. 3).
+    pub clamp: bool,
+    pub damping: TangentialDamping,
+    pub arm: RollingArm,
 }
 
 impl Continuous {
@@ -48,6 +62,11 @@ impl Continuous {
             alpha: s.alpha,
             damping_fraction: s.damping_fraction,
             g,
+            reading: Reading {
+                clamp: s.clamp,
+                damping: s.tangential_damping,
+                arm: s.rolling_arm,
+            },
         })
     }
 
@@ -81,6 +100,11 @@ impl Continuous {
             alpha: s.alpha,
             damping_fraction: s.damping_fraction,
             g,
+            reading: Reading {
+                clamp: s.clamp,
+                damping: s.tangential_damping,
+                arm: s.rolling_arm,
+            },
         })
     }
 
@@ -92,25 +116,41 @@ impl Continuous {
         let m = c.mass;
         let f_e = self.elastic_force(m, c.sigma, c.r);
         let k = self.elastic_stiffness(m, c.sigma, c.r);
-        // Paper 001 eq. 3: C_N = 50 % of critical damping 2 sqrt(m k(r)).
+        // Paper 001 eq. 3: C_N = 50 % of critical damping 2 sqrt(m k(r)), added to F_e
+        // without a clamp unless the scene asks for one: in the tail σ < r < r0 a
+        // separating pair is pulled back by its damping (the paper's "endurance").
         let c_n = self.damping_fraction * 2.0 * (m * k).sqrt();
-        let f_n = clamp_non_negative(f_e + c_n * c.delta_dot);
+        let f_n = f_e + c_n * c.delta_dot;
+        let f_n = if self.reading.clamp {
+            clamp_non_negative(f_n)
+        } else {
+            f_n
+        };
 
         // δ_N = r0 − r; δ_max = α μ δ_N (paper 001 after eq. 6).
         let delta_n = (self.r0 * c.sigma - c.r).max(0.0);
         let delta_max = self.alpha * self.mu * delta_n;
-        // Eq. 6: δ_F accumulates the tangential relative velocity at the contact point
-        // (rolling of both disks included in v_t). It is held at ±δ_max while sliding so
-        // that a reversal starts from the Coulomb limit rather than unwinding a long
-        // excursion (the paper leaves this open).
-        let delta_f = (c.history + c.v_t * c.dt).clamp(-delta_max, delta_max);
+        // Eq. 6: δ_F accumulates ṙ_ij · t̂ − (θ̇_i + θ̇_j) r_ij, the spins' arm the centre
+        // distance as written, or each disk's own (the surfaces' slip, `v_t`). It is held
+        // at ±δ_max while sliding so that a reversal starts from the Coulomb limit rather
+        // than unwinding a long excursion (the paper leaves this open).
+        let slip = match self.reading.arm {
+            RollingArm::CentreDistance => c.v_centres - c.spin * c.r,
+            RollingArm::ContactPoint => c.v_t,
+        };
+        let delta_f = (c.history + slip * c.dt).clamp(-delta_max, delta_max);
         let mu_f_e = self.mu * f_e;
         let spring = tapered_friction(delta_f, delta_max, mu_f_e);
         let k_t = tapered_stiffness(delta_f, delta_max, mu_f_e);
-        // Eq. 8: C_T = 50 % of critical, sqrt(m k_T).
+        // Eq. 8: C_T = 50 % of critical, sqrt(m k_T), on the velocity eq. 4 names, the
+        // centres' ṙ_ij · t̂, or on the surfaces' slip.
         let c_t = self.damping_fraction * 2.0 * (m * k_t).sqrt();
-        let f_t = -spring.copysign(delta_f) - c_t * c.v_t;
-        let f_t = if delta_f == 0.0 { -c_t * c.v_t } else { f_t };
+        let v_damped = match self.reading.damping {
+            TangentialDamping::Centres => c.v_centres,
+            TangentialDamping::Slip => c.v_t,
+        };
+        let f_t = -spring.copysign(delta_f) - c_t * v_damped;
+        let f_t = if delta_f == 0.0 { -c_t * v_damped } else { f_t };
 
         let energy =
             self.elastic_energy(m, c.sigma, c.r) + tapered_energy(delta_f, delta_max, mu_f_e);
@@ -197,7 +237,76 @@ mod tests {
             alpha: 1.214,
             damping_fraction: 0.5,
             g: 1.0,
+            reading: Reading::default(),
         }
+    }
+
+    /// A pair of unit disks at r in the tail, separating at 0.5 √(gσ), with the
+    /// surfaces slipping at `v_t`, the centres at `v_centres` and the spins summing to
+    /// `spin`.
+    fn tail_input(v_t: f64, v_centres: f64, spin: f64) -> ContactInput {
+        ContactInput {
+            delta: -0.1,
+            r: 1.1,
+            sigma: 1.0,
+            delta_dot: -0.5,
+            v_t,
+            v_centres,
+            spin,
+            m12: 0.5,
+            mass: 1.0,
+            history: 0.0,
+            dt: 1e-3,
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn eq_3_holds_a_separating_pair_back_unless_clamped() {
+        // Paper 001 eq. 3: F_N = F_e − C_N ṙ·n̂, no clamp: in the tail a pair separating
+        // faster than F_e / C_N is pulled together.
+        let mut l = law();
+        let c = tail_input(0.0, 0.0, 0.0);
+        let (f_e, k) = (
+            l.elastic_force(1.0, 1.0, 1.1),
+            l.elastic_stiffness(1.0, 1.0, 1.1),
+        );
+        let want = f_e - 0.5 * 2.0 * k.sqrt() * 0.5;
+        assert!(want < 0.0, "the damping outweighs F_e here ({want})");
+        assert!((l.evaluate(&c).f_n - want).abs() < 1e-15);
+        l.reading.clamp = true;
+        assert_eq!(l.evaluate(&c).f_n, 0.0);
+    }
+
+    #[test]
+    fn eq_4_damps_the_centres_and_eq_6_turns_the_spins_on_the_centre_distance() {
+        let mut l = law();
+        // Two disks spinning the same way at ω = 2 with still centres: their surfaces
+        // slip at −ω (a_1 + a_2) = −ω r, the arms meeting at the contact point.
+        let (omega, r, dt) = (2.0, 1.1, 1e-3);
+        let v_t = -omega * r; // the physical slip with arms summing to r
+        let c = tail_input(v_t, 0.0, 2.0 * omega);
+        let out = l.evaluate(&c);
+        // Eq. 6 as written: δ_F = −(θ̇_i + θ̇_j) r_ij dt = −2 ω r dt, twice the slip.
+        assert!((out.history - (-2.0 * omega * r * dt)).abs() < 1e-15);
+        // Eq. 4: the centres do not move, so no damping: f_t is the spring alone.
+        let delta_max = l.alpha * l.mu * (l.r0 - r);
+        let spring = tapered_friction(out.history, delta_max, l.mu * l.elastic_force(1.0, 1.0, r));
+        assert!(
+            (out.f_t - spring).abs() < 1e-15,
+            "{} against {spring}",
+            out.f_t
+        );
+        // The other readings: δ_F from the slip, and the slip damped.
+        l.reading.arm = RollingArm::ContactPoint;
+        l.reading.damping = TangentialDamping::Slip;
+        let out = l.evaluate(&c);
+        assert!((out.history - v_t * dt).abs() < 1e-15);
+        let mu_f_e = l.mu * l.elastic_force(1.0, 1.0, r);
+        let k_t = tapered_stiffness(out.history, delta_max, mu_f_e);
+        let c_t = 0.5 * 2.0 * k_t.sqrt();
+        let want = tapered_friction(out.history, delta_max, mu_f_e) - c_t * v_t;
+        assert!((out.f_t - want).abs() < 1e-12, "{} against {want}", out.f_t);
     }
 
     #[test]

@@ -27,8 +27,14 @@ pub struct ContactInput {
     pub sigma: f64,
     /// Rate of overlap dδ/dt = −v12·n.
     pub delta_dot: f64,
-    /// Tangential relative velocity at the contact point, v12·t.
+    /// Tangential relative velocity at the contact point, v12·t (the surfaces' slip,
+    /// spins included).
     pub v_t: f64,
+    /// The continuous law's other readings of it (paper 001 eq. 4 and 6): the centres'
+    /// relative velocity along t, and the sum of the spins θ̇_1 + θ̇_2 (θ̇_1 against a
+    /// wall). Other laws ignore them.
+    pub v_centres: f64,
+    pub spin: f64,
     /// Reduced mass m12 = m1 m2 / (m1 + m2) (m1 for a wall).
     pub m12: f64,
     /// Mass scale m of the continuous law: 2 m12 for two disks (the particle mass for

@@ -367,6 +367,16 @@ pub struct ContinuousSpec {
     /// Force scale g in F = m g (σ/r)^(n+1); defaults to |gravity.g|.
     #[serde(default)]
     pub g: Option<f64>,
+    /// Clamp f_n ≥ 0 after the damping (SPEC 2): false, the default, follows paper 001
+    /// eq. 3, where a separating pair in the tail σ < r < r0 is held back by its damping.
+    #[serde(default)]
+    pub clamp: bool,
+    /// The velocity the tangential damping of eq. 4 acts on.
+    #[serde(default)]
+    pub tangential_damping: TangentialDamping,
+    /// The arm of the disks' spin in eq. 6's slip.
+    #[serde(default)]
+    pub rolling_arm: RollingArm,
 }
 
 /// Hooke law equivalent to the continuous one by equal work (paper 001 eq. 14).
@@ -391,6 +401,42 @@ pub struct HookeEquivalentSpec {
     pub damping_fraction: f64,
     #[serde(default)]
     pub g: Option<f64>,
+    /// Clamp f_n ≥ 0 after the damping (SPEC 2): false, the default, follows paper 001
+    /// eq. 3, where a separating pair in the tail σ < r < r0 is held back by its damping.
+    #[serde(default)]
+    pub clamp: bool,
+    /// The velocity the tangential damping of eq. 4 acts on.
+    #[serde(default)]
+    pub tangential_damping: TangentialDamping,
+    /// The arm of the disks' spin in eq. 6's slip.
+    #[serde(default)]
+    pub rolling_arm: RollingArm,
+}
+
+/// What paper 001 eq. 4's tangential damping −C_T (ṙ_ij · t̂) acts on (SPEC 2.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TangentialDamping {
+    /// ṙ_ij · t̂, the relative velocity of the centres, as eq. 4 writes it: the spins
+    /// do not enter, so a disk spinning in place against its neighbour is not damped,
+    /// and one rolling over it is.
+    #[default]
+    Centres,
+    /// The slip of the two surfaces at the contact point, spins included (what talus
+    /// did before issue 39).
+    Slip,
+}
+
+/// The arm of the spins in paper 001 eq. 6's slip, δ_F = ∫ ṙ_ij · t̂ − (θ̇_i + θ̇_j) a.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RollingArm {
+    /// a = r_ij, the centre distance, as eq. 6 writes it: twice the physical arm.
+    #[default]
+    CentreDistance,
+    /// Each disk's own distance to the contact point (σ/2 for equal disks): the surfaces'
+    /// physical slip (what talus did before issue 39).
+    ContactPoint,
 }
 
 fn default_n() -> f64 {
