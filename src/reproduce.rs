@@ -176,13 +176,25 @@ pub fn variants(id: &str, size: Size) -> Result<Vec<Variant>, ReproductionError>
             }
             out
         }
-        "R4" => vec![v(
-            "pour",
-            if full { R4 } else { R4_REDUCED },
-            &[],
-            14.0,
-            1.0,
-        )],
+        // The law as paper 001 writes it (the default), and as talus read it before
+        // issue 39: clamped, the slip damped, the spins on their own arms.
+        "R4" => {
+            let base = if full { R4 } else { R4_REDUCED };
+            vec![
+                v("pour", base, &[], 14.0, 1.0),
+                v(
+                    "pour-clamped-slip",
+                    base,
+                    &[
+                        "contact.clamp=true",
+                        "contact.tangential_damping=slip",
+                        "contact.rolling_arm=contact_point",
+                    ],
+                    14.0,
+                    1.0,
+                ),
+            ]
+        }
         // R5: R4 with the Hooke law of equal work, a short tail, and polydispersity.
         "R5" => {
             let base = if full { R4 } else { R4_REDUCED };
