@@ -5,11 +5,13 @@
 //! values (positive radii, known materials, a time step the stiffness allows) and names
 //! the offending key too. Nothing downstream re-checks user input.
 
+mod contact;
 mod overrides;
 mod schema;
 mod strict;
 mod validate;
 
+pub use contact::*;
 pub use overrides::apply_override;
 pub use schema::*;
 pub use validate::{
