@@ -519,6 +519,16 @@ fn cmd_analyze(
         s.repose_left,
         s.repose_right
     );
+    let r = &s.repose_readings;
+    out!(
+        "  read other ways (left / right): middle third of the height {} / {}, apex to toe {} / {}, steepest stretch {} / {}",
+        degrees(r.middle[0].angle_deg),
+        degrees(r.middle[1].angle_deg),
+        degrees(r.apex_toe[0].angle_deg),
+        degrees(r.apex_toe[1].angle_deg),
+        degrees(r.steepest[0].angle_deg),
+        degrees(r.steepest[1].angle_deg)
+    );
     out!(
         "coordination: {:.3} all, {:.3} without {} rattlers, {:.3} interior; packing fraction {:.3} (lower half)",
         s.coordination.all,

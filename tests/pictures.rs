@@ -298,7 +298,7 @@ fn units_follow_the_scene_and_every_field_but_plain_has_a_bar() {
 fn every_picture_has_a_length_scale_of_a_round_length_drawn_to_scale() {
     let a = column("reduced");
     let dir = draw(&a, Field::Pressure, "scale");
-    for stem in ["grains", "forces", "stress_crosses"] {
+    for stem in ["grains", "forces", "stress_crosses", "repose"] {
         let svg = std::fs::read_to_string(dir.join(format!("{stem}.svg"))).unwrap();
         let part = group(&svg, "length-scale");
         let words = texts(&part);
@@ -381,6 +381,61 @@ fn the_force_network_and_stress_crosses_have_keys_in_units() {
     }
 }
 
+/// The angle of repose read four ways (issue 39): one key entry per reading in its
+/// line's colour with both flanks' angles as `talus analyze` measured them, and each
+/// reading's lines drawn in that colour.
+#[test]
+fn the_repose_picture_keys_each_reading_with_its_angles() {
+    let a = column("reduced");
+    let dir = draw(&a, Field::Pressure, "repose");
+    let svg = std::fs::read_to_string(dir.join("repose.svg")).unwrap();
+    let key = group(&svg, "line-key");
+    let words = texts(&key);
+    assert_eq!(
+        text(&words, "label").words,
+        "angle of repose [deg], left/right"
+    );
+    let values: Vec<&Text> = words.iter().filter(|t| t.class == "value").collect();
+    let s = &a.summary;
+    let r = &s.repose_readings;
+    let deg = |v: f64| {
+        if v.is_finite() {
+            format!("{v:.1}")
+        } else {
+            "-".into()
+        }
+    };
+    let want = [
+        ("band", [&s.repose_left, &s.repose_right], INK),
+        ("middle", [&r.middle[0], &r.middle[1]], [30, 90, 210]),
+        ("apex-toe", [&r.apex_toe[0], &r.apex_toe[1]], [230, 130, 0]),
+        ("steepest", [&r.steepest[0], &r.steepest[1]], [200, 30, 120]),
+    ];
+    assert_eq!(values.len(), want.len());
+    let png = Pixmap::load_png(dir.join("repose.png")).unwrap();
+    for (t, (name, flanks, colour)) in values.iter().zip(want) {
+        let text = format!(
+            "{name} {}/{}",
+            deg(flanks[0].angle_deg),
+            deg(flanks[1].angle_deg)
+        );
+        assert_eq!(t.words, text);
+        assert_spelled(&png, t, colour);
+        let stroke = format!("stroke=\"rgb({},{},{})\"", colour[0], colour[1], colour[2]);
+        let drawn = svg
+            .lines()
+            .filter(|l| l.starts_with("<line") && l.contains(&stroke));
+        let lines = flanks
+            .iter()
+            .filter(|f| f.line.iter().flatten().all(|v| v.is_finite()));
+        assert_eq!(
+            drawn.count(),
+            lines.count(),
+            "{name}: a line per flank read"
+        );
+    }
+}
+
 #[test]
 fn every_plot_labels_both_axes_with_units() {
     let a = column("reduced");
@@ -389,7 +444,7 @@ fn every_plot_labels_both_axes_with_units() {
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "svg"))
         .filter(|p| {
-            !["grains", "forces", "stress_crosses"]
+            !["grains", "forces", "stress_crosses", "repose"]
                 .iter()
                 .any(|s| p.ends_with(format!("{s}.svg")))
         })

@@ -141,7 +141,13 @@ pub struct Slope {
     /// RMS distance of the fitted points from the line, vertical, in length units.
     pub residual: f64,
     pub points: usize,
+    /// The line's ends over the points it was read from, [[x, z], [x, z]] (NaN where
+    /// there is no line): what the pictures draw.
+    pub line: [[f64; 2]; 2],
 }
+
+/// No line.
+const NO_LINE: [[f64; 2]; 2] = [[f64::NAN; 2]; 2];
 
 impl std::fmt::Display for Slope {
     /// The angle with its fit, or why there is none (a box deposit has no free slope
@@ -172,32 +178,109 @@ pub fn repose(surface: &mut [SurfacePoint], o: &Outline, lo: f64, hi: f64) -> (S
                 pts.push((p.x, p.z));
             }
         }
-        let n = pts.len();
-        if n < 2 {
-            return Slope {
-                points: n,
-                angle_deg: f64::NAN,
-                residual: f64::NAN,
-            };
-        }
-        let mx = pts.iter().map(|p| p.0).sum::<f64>() / n as f64;
-        let mz = pts.iter().map(|p| p.1).sum::<f64>() / n as f64;
-        let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
-        let sxz: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - mz)).sum();
-        let b = sxz / sxx;
-        let res = (pts
-            .iter()
-            .map(|p| (p.1 - mz - b * (p.0 - mx)).powi(2))
-            .sum::<f64>()
-            / n as f64)
-            .sqrt();
-        Slope {
-            angle_deg: (b * -(side as f64)).atan().to_degrees(),
-            residual: res,
-            points: n,
-        }
+        line_fit(&pts, side)
     };
     (fit(-1), fit(1))
+}
+
+/// The least-squares line through `pts` as the slope of a flank on `side` (-1 left of
+/// the apex, +1 right): its angle falling away from the apex and its RMS residual.
+fn line_fit(pts: &[(f64, f64)], side: i8) -> Slope {
+    let n = pts.len();
+    if n < 2 {
+        return Slope {
+            points: n,
+            angle_deg: f64::NAN,
+            residual: f64::NAN,
+            line: NO_LINE,
+        };
+    }
+    let mx = pts.iter().map(|p| p.0).sum::<f64>() / n as f64;
+    let mz = pts.iter().map(|p| p.1).sum::<f64>() / n as f64;
+    let sxx: f64 = pts.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    let sxz: f64 = pts.iter().map(|p| (p.0 - mx) * (p.1 - mz)).sum();
+    let b = sxz / sxx;
+    let res = (pts
+        .iter()
+        .map(|p| (p.1 - mz - b * (p.0 - mx)).powi(2))
+        .sum::<f64>()
+        / n as f64)
+        .sqrt();
+    let (x0, x1) = pts
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(p.0), hi.max(p.0))
+        });
+    let at = |x: f64| [x, mz + b * (x - mx)];
+    Slope {
+        angle_deg: (b * -(side as f64)).atan().to_degrees(),
+        residual: res,
+        points: n,
+        line: [at(x0), at(x1)],
+    }
+}
+
+/// The angle of repose of each flank read three more ways than `repose`'s band
+/// (issue 39: paper 001 reads "the angle between the inclined surface and the base" off
+/// its Fig. 1, and a heap with a rounded cap and a foot running out over the base reads
+/// differently by each rule). [left, right].
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Readings {
+    /// A fit to the middle third of the height: the cap (top third) and the foot
+    /// (bottom third) left out.
+    pub middle: [Slope; 2],
+    /// The line from the apex (the top of the highest grain) to the toe (the outer
+    /// edge of the outline at the base): atan(height / run).
+    pub apex_toe: [Slope; 2],
+    /// The steepest fit over any run of consecutive surface points a third of the
+    /// flank's points long (at least 4): the steepest stretch. Biased upwards by the
+    /// surface's grain-scale roughness (a maximum over noisy fits).
+    pub steepest: [Slope; 2],
+}
+
+impl Readings {
+    /// Both flanks' mean angle of a reading, in degrees.
+    pub fn mean(r: &[Slope; 2]) -> f64 {
+        0.5 * (r[0].angle_deg + r[1].angle_deg)
+    }
+}
+
+/// The readings of both flanks of `surface` (`Readings`).
+pub fn readings(surface: &[SurfacePoint], o: &Outline) -> Readings {
+    let mut r = Readings::default();
+    for (k, side) in [(0, -1i8), (1, 1)] {
+        // The flank from the apex outwards.
+        let mut flank: Vec<(f64, f64)> = (surface.iter())
+            .filter(|p| p.side == side)
+            .map(|p| (p.x, p.z))
+            .collect();
+        flank.sort_by(|a, b| (side as f64 * a.0).total_cmp(&(side as f64 * b.0)));
+        let h = |p: &(f64, f64)| (p.1 - o.base) / o.height;
+        let middle: Vec<(f64, f64)> = (flank.iter())
+            .filter(|p| (1.0 / 3.0..=2.0 / 3.0).contains(&h(p)))
+            .copied()
+            .collect();
+        r.middle[k] = line_fit(&middle, side);
+        let toe = if side < 0 { o.left } else { o.right };
+        let run = (toe - o.apex_x).abs();
+        r.apex_toe[k] = Slope {
+            angle_deg: if run > 0.0 {
+                (o.height / run).atan().to_degrees()
+            } else {
+                f64::NAN
+            },
+            residual: f64::NAN,
+            points: 2,
+            line: [[o.apex_x, o.top], [toe, o.base]],
+        };
+        let w = flank.len().div_ceil(3).max(4);
+        r.steepest[k] = (flank.windows(w))
+            .map(|pts| line_fit(pts, side))
+            .filter(|s| s.angle_deg.is_finite())
+            .max_by(|a, b| a.angle_deg.total_cmp(&b.angle_deg))
+            .unwrap_or_else(|| line_fit(&[], side));
+    }
+    r
 }
 
 /// The base pressure from wall contacts: the vertical force the walls carry from grains
@@ -278,12 +361,85 @@ pub fn smoothed_loads(base: &[BaseForce], span: usize) -> Vec<(f64, f64)> {
 mod tests {
     use super::*;
 
+    /// A trapezoid heap 10 high: a flat cap 10 wide, flanks at 40° (left) and 30°
+    /// (right) from the cap down to a foot 1 high that runs out 6 further. Every reading
+    /// finds the flanks' angle where its rule sees only the flank, and departs from it
+    /// by what its rule takes in of the cap and the foot.
+    #[test]
+    fn each_reading_of_the_angle_follows_its_rule() {
+        let (lt, rt) = (40f64.to_radians().tan(), 30f64.to_radians().tan());
+        // From the apex outwards: cap to x = ±5, flank down to z = 1, foot at z = 1.
+        let (l_run, r_run) = (9.0 / lt, 9.0 / rt);
+        let height = |x: f64| {
+            let (t, run) = if x < 0.0 { (lt, l_run) } else { (rt, r_run) };
+            let a = x.abs() - 5.0;
+            if a <= 0.0 {
+                10.0
+            } else if a <= run {
+                10.0 - t * a
+            } else {
+                1.0
+            }
+        };
+        let (left, right) = (-(5.0 + l_run + 6.0), 5.0 + r_run + 6.0);
+        let o = Outline {
+            base: 0.0,
+            top: 10.0,
+            height: 10.0,
+            left,
+            right,
+            width: right - left,
+            apex_x: 0.0,
+        };
+        let n = (o.width / 0.25) as usize;
+        let surface: Vec<SurfacePoint> = (0..n)
+            .map(|k| {
+                let x = left + (k as f64 + 0.5) * 0.25;
+                SurfacePoint {
+                    x,
+                    z: height(x),
+                    grain: k,
+                    side: (x.signum() as i8) * (x.abs() > 0.125) as i8,
+                    fitted: false,
+                }
+            })
+            .collect();
+        let r = readings(&surface, &o);
+        // The middle third (heights 3.3–6.7) lies on the flanks alone.
+        let a = |s: &[Slope; 2]| [s[0].angle_deg, s[1].angle_deg];
+        let (middle, apex_toe, steepest) = (a(&r.middle), a(&r.apex_toe), a(&r.steepest));
+        assert!((middle[0] - 40.0).abs() < 1e-9 && (middle[1] - 30.0).abs() < 1e-9);
+        // Apex to toe: the cap and the foot lengthen the run.
+        let want = |run: f64| (10f64 / (5.0 + run + 6.0)).atan().to_degrees();
+        assert!((apex_toe[0] - want(l_run)).abs() < 1e-12);
+        assert!((apex_toe[1] - want(r_run)).abs() < 1e-12);
+        assert!(apex_toe[0] < 30.0 && apex_toe[1] < 25.0);
+        assert_eq!(r.apex_toe[1].line, [[0.0, 10.0], [right, 0.0]]);
+        // The steepest stretch is the flank itself where a third of the points fit on
+        // it: the right flank is 15.6 long of 32.6 from the apex.
+        assert!((steepest[1] - 30.0).abs() < 1e-9, "{steepest:?}");
+        // Each fitted line lies on the flank it read: at its ends, the heap's surface.
+        for s in [&r.middle[1], &r.steepest[1]] {
+            for [x, z] in s.line {
+                assert!((z - height(x)).abs() < 1e-9, "{:?}", s.line);
+            }
+        }
+        // The band 15–85 % sees the flanks alone here (the foot is 10 % high); a band
+        // from 5 % takes in the foot and reads low.
+        let mut s = surface.clone();
+        let (band_l, band_r) = repose(&mut s, &o, 0.15, 0.85);
+        assert!((band_l.angle_deg - 40.0).abs() < 1e-9 && (band_r.angle_deg - 30.0).abs() < 1e-9);
+        let (low_l, low_r) = repose(&mut s, &o, 0.05, 0.85);
+        assert!(low_l.angle_deg < 38.0 && low_r.angle_deg < 28.0);
+    }
+
     #[test]
     fn a_slope_prints_its_fit_or_that_there_is_none() {
         let fitted = Slope {
             angle_deg: 31.25,
             residual: 0.012,
             points: 40,
+            line: NO_LINE,
         };
         assert_eq!(fitted.to_string(), "31.2° (rms 1.20e-2, 40 points)");
         let outline = Outline {

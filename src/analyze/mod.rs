@@ -138,6 +138,8 @@ pub struct Summary {
     pub outline: heap::Outline,
     pub repose_left: heap::Slope,
     pub repose_right: heap::Slope,
+    /// The angle of each flank read three more ways (`heap::Readings`).
+    pub repose_readings: heap::Readings,
     pub coordination: network::Coordination,
     pub forces: ForceSummary,
     /// Mean packing fraction of the layers below half the height.
@@ -263,6 +265,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
     );
     let mut surface = heap::surface(grains, &o, opt.surface_bin * d);
     let (left, right) = heap::repose(&mut surface, &o, opt.fit_from, opt.fit_to);
+    let repose_readings = heap::readings(&surface, &o);
     let mut on_surface = vec![false; grains.len()];
     surface.iter().for_each(|p| on_surface[p.grain] = true);
     let counts = network::contact_counts(grains, &input.touches);
@@ -351,6 +354,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
         outline: o,
         repose_left: left,
         repose_right: right,
+        repose_readings,
         coordination,
         forces: ForceSummary {
             contacts: input.touches.len(),

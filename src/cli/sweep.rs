@@ -633,13 +633,16 @@ pub fn reproduce(
             })
         };
         out!(
-            "{id} {} ({} of {} seeds measured): repose left {}, right {}, mean {}; height {} d; packing {}; Z interior {}; S_zz(1) apex {} max {}; base load centre {} side max {} m g, ratio {}, dip above noise {} m g",
+            "{id} {} ({} of {} seeds measured): repose left {}, right {}, mean {} (middle third {}, apex to toe {}, steepest stretch {}); height {} d; packing {}; Z interior {}; S_zz(1) apex {} max {}; base load centre {} side max {} m g, ratio {}, dip above noise {} m g",
             v.name,
             point.measured,
             point.runs,
             show("repose_left_deg", "°"),
             show("repose_right_deg", "°"),
             show("repose_mean_deg", "°"),
+            show("repose_middle_deg", "°"),
+            show("repose_apex_toe_deg", "°"),
+            show("repose_steepest_deg", "°"),
             show("height_d", ""),
             show("packing_fraction_lower_half", ""),
             show("coordination_interior", ""),

@@ -315,6 +315,9 @@ const GREY: [u8; 3] = [200, 200, 200];
 const INK: [u8; 3] = [30, 30, 30];
 const COMPRESSION: [u8; 3] = [30, 60, 200];
 const TENSION: [u8; 3] = [200, 40, 40];
+const MIDDLE: [u8; 3] = [30, 90, 210];
+const APEX_TOE: [u8; 3] = [230, 130, 0];
+const STEEPEST: [u8; 3] = [200, 30, 120];
 
 /// Writes every picture of `a` into `dir`; `width` is the pictures' width in pixels.
 pub fn render(
@@ -428,6 +431,52 @@ pub fn render(
     }
     legend::length_scale(&mut c, &a.input.length_unit);
     c.save(dir, "stress_crosses", &mut files)?;
+    repose_lines(a, view, line)?.save(dir, "repose", &mut files)?;
     files.extend(plots::write_plots(a, dir)?);
     Ok(files)
+}
+
+/// The angle of repose as each rule reads it (`analyze::heap::Readings`): the surface
+/// points (the band's fitted ones dark), and the lines of the band fit, the middle
+/// third, apex to toe and the steepest stretch over faint grains, each flank's angle
+/// in the key.
+fn repose_lines(a: &Analysis, view: View, line: f32) -> Result<Canvas, RenderError> {
+    let mut c = Canvas::new(view)?;
+    for g in &a.input.grains {
+        let fill = if g.fixed {
+            [190, 190, 190]
+        } else {
+            [235, 235, 235]
+        };
+        c.shape(g, fill, Some(GREY), 0.5 * line);
+    }
+    let s = &a.summary;
+    let r = &s.repose_readings;
+    let readings = [
+        (INK, "band", [&s.repose_left, &s.repose_right]),
+        (MIDDLE, "middle", [&r.middle[0], &r.middle[1]]),
+        (APEX_TOE, "apex-toe", [&r.apex_toe[0], &r.apex_toe[1]]),
+        (STEEPEST, "steepest", [&r.steepest[0], &r.steepest[1]]),
+    ];
+    let mut key = Vec::new();
+    for (colour, name, flanks) in readings {
+        for f in flanks {
+            let [p, q] = f.line;
+            if p.iter().chain(&q).all(|v| v.is_finite()) {
+                c.line((p[0], p[1]), (q[0], q[1]), 2.0 * line, colour);
+            }
+        }
+        let deg = |v: f64| {
+            if v.is_finite() {
+                format!("{v:.1}")
+            } else {
+                "-".into()
+            }
+        };
+        let (l, r) = (flanks[0].angle_deg, flanks[1].angle_deg);
+        key.push((colour, format!("{name} {}/{}", deg(l), deg(r))));
+    }
+    legend::length_scale(&mut c, &a.input.length_unit);
+    legend::line_key(&mut c, "angle of repose [deg], left/right", &key);
+    Ok(c)
 }

@@ -734,6 +734,9 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
                 ));
             }
         }
+        if let Some(w) = impact_warning(scene, &law) {
+            warnings.push(w);
+        }
         if let Some(w) = gpu_resolution_warning(scene, &law) {
             warnings.push(w);
         }
@@ -742,6 +745,46 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
         }
     }
     Ok(warnings)
+}
+
+/// The largest C_N dt / m12 under Gear at which poured grains of the unclamped
+/// continuous law still settle. Measured on paper 001's pour (n = 36, r0 = 1.2σ,
+/// dt = 0.001, issue 39): from 30σ (0.34 at the fastest impact) 8 seeds of 8 settled;
+/// from 100σ (0.64) 7 of 8 diverged within t = 27–87 (leapfrog: see docs/REPRODUCTION.md).
+pub const IMPACT_DAMPING_STABILITY: f64 = 0.45;
+
+/// Gear with the continuous law unclamped (paper 001 eq. 3): a grain from a point
+/// source lands at sqrt(v0² + 2 g h) (h: from the source down to the domain's floor),
+/// and at its closest approach the damping C_N = ζ 2 sqrt(m k(r)) is hundreds of times
+/// the resting one; Gear's predictor-corrector then amplifies it (the clamp happened
+/// to stop that). Leapfrog, the paper's integrator (eq. 9–12), takes it.
+fn impact_warning(scene: &Scene, law: &ContactLaw) -> Option<String> {
+    let ContactLaw::Continuous(l) = law else {
+        return None;
+    };
+    if l.reading.clamp || scene.integrator != crate::scene::IntegratorKind::Gear5 {
+        return None;
+    }
+    let g = scene.gravity.g[0].hypot(scene.gravity.g[1]);
+    let (k, rate) = (scene.particles.iter().enumerate())
+        .filter_map(|(k, c)| match c {
+            Creation::PointSource(p) => {
+                let h = (p.position[1] - scene.domain.z[0]).max(0.0);
+                let v0 = p.velocity[0].hypot(p.velocity[1]) + p.velocity_spread;
+                let v = (v0 * v0 + 2.0 * g * h).sqrt();
+                let (d, _) = size_bounds(c);
+                Some((k, l.impact_damping_rate(d, v)))
+            }
+            _ => None,
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))?;
+    let ratio = rate * scene.dt;
+    (ratio > IMPACT_DAMPING_STABILITY).then(|| {
+        format!(
+            "particles[{k}]: its grains land with a normal damping C_N dt/m12 = {ratio:.2} at their closest approach (continuous law, unclamped, paper 001 eq. 3), above {IMPACT_DAMPING_STABILITY}, where Gear diverged on paper 001's pour; use \"integrator\": \"leapfrog\" (the paper's) or dt ≤ {:.1e}",
+            scene.dt * IMPACT_DAMPING_STABILITY / ratio
+        )
+    })
 }
 
 /// Rods (spheropolygons) and law `hertz_cohesive` go together (issue 15): rods need the

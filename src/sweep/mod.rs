@@ -22,6 +22,7 @@ pub mod collect;
 pub mod slurm;
 
 use crate::analyze::Analysis;
+use crate::analyze::heap::Readings;
 use crate::files::write_atomic;
 use crate::reproduce::{self, Findings};
 use crate::scene::{self, Scene, SceneError};
@@ -481,6 +482,15 @@ pub struct Measures {
     pub repose_left_deg: f64,
     #[serde(deserialize_with = "nan_if_null")]
     pub repose_right_deg: f64,
+    /// Both flanks' mean angle by the other readings (`analyze::heap::Readings`): the
+    /// middle third of the height, apex to toe, the steepest stretch; None in a
+    /// measures.json from before them (or null for a flank with nothing to fit).
+    #[serde(default)]
+    pub repose_middle_deg: Option<f64>,
+    #[serde(default)]
+    pub repose_apex_toe_deg: Option<f64>,
+    #[serde(default)]
+    pub repose_steepest_deg: Option<f64>,
     /// Height of the heap in mean diameters.
     #[serde(deserialize_with = "nan_if_null")]
     pub height_d: f64,
@@ -547,6 +557,9 @@ impl Measures {
             time: f.time,
             repose_left_deg: f.repose_left_deg,
             repose_right_deg: f.repose_right_deg,
+            repose_middle_deg: Some(Readings::mean(&s.repose_readings.middle)),
+            repose_apex_toe_deg: Some(Readings::mean(&s.repose_readings.apex_toe)),
+            repose_steepest_deg: Some(Readings::mean(&s.repose_readings.steepest)),
             height_d: s.outline.height / d,
             packing_fraction_lower_half: f.packing_fraction_lower_half,
             coordination_interior: f.coordination_interior,
@@ -581,6 +594,9 @@ impl Measures {
                 "repose_mean_deg",
                 0.5 * (self.repose_left_deg + self.repose_right_deg),
             ),
+            ("repose_middle_deg", opt(self.repose_middle_deg)),
+            ("repose_apex_toe_deg", opt(self.repose_apex_toe_deg)),
+            ("repose_steepest_deg", opt(self.repose_steepest_deg)),
             ("height_d", self.height_d),
             (
                 "packing_fraction_lower_half",
