@@ -12,10 +12,14 @@ macro_rules! out {
         let _ = writeln!(std::io::stdout(), $($t)*);
     }};
 }
+#[path = "cli/analyze.rs"]
+mod analyze;
 #[path = "cli/check.rs"]
 mod check;
 #[path = "cli/failure.rs"]
 mod failure;
+#[path = "cli/reproduce.rs"]
+mod reproduce;
 #[path = "cli/sweep.rs"]
 mod sweep;
 
@@ -315,7 +319,7 @@ fn command(command: Command, threads: usize) -> ExitCode {
             g,
             from,
             fit,
-        } => cmd_analyze(&path, out, window, step, row, g, from, [fit[0], fit[1]]),
+        } => analyze::cmd_analyze(&path, out, window, step, row, g, from, [fit[0], fit[1]]),
         Command::Render {
             path,
             out,
@@ -323,7 +327,7 @@ fn command(command: Command, threads: usize) -> ExitCode {
             width,
             window,
             g,
-        } => cmd_render(&path, out, color, width, window, g),
+        } => analyze::cmd_render(&path, out, color, width, window, g),
         Command::Reproduce {
             id,
             full,
@@ -341,7 +345,7 @@ fn command(command: Command, threads: usize) -> ExitCode {
                 jobs,
                 threads,
             };
-            let size = reproduction_size(full, rods);
+            let size = reproduce::reproduction_size(full, rods);
             sweep::reproduce(&id, size, only.as_deref(), &seeds, out, backend, quiet)
         }
         Command::Reproduce {
@@ -356,8 +360,8 @@ fn command(command: Command, threads: usize) -> ExitCode {
             quiet,
             ..
         } => {
-            let size = reproduction_size(full, rods);
-            cmd_reproduce(&id, size, only.as_deref(), reuse, out, backend, quiet)
+            let size = reproduce::reproduction_size(full, rods);
+            reproduce::cmd_reproduce(&id, size, only.as_deref(), reuse, out, backend, quiet)
         }
         Command::Sweep(args) => sweep::cmd_sweep(args, threads),
         Command::Bench {
@@ -435,215 +439,6 @@ fn beside(path: &std::path::Path, name: &str) -> PathBuf {
     path.with_file_name(format!("{stem}_{name}"))
 }
 
-fn cmd_analyze(
-    path: &std::path::Path,
-    out: Option<PathBuf>,
-    window: f64,
-    step: f64,
-    row: f64,
-    g: Option<f64>,
-    from: Option<f64>,
-    fit: [f64; 2],
-) -> Result<(), Failure> {
-    use talus::analyze;
-    if !(0.0 <= fit[0] && fit[0] < fit[1] && fit[1] <= 1.0) {
-        return Err(Failure::input(format!(
-            "--fit {} {}: needs 0 <= FROM < TO <= 1 (fractions of the heap's height)",
-            fit[0], fit[1]
-        )));
-    }
-    for (name, v) in [("--window", window), ("--step", step), ("--row", row)] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(Failure::input(format!(
-                "{name} must be a positive number of diameters, not {v}"
-            )));
-        }
-    }
-    if let Some(g) = g.filter(|g| !(g.is_finite() && *g > 0.0)) {
-        return Err(Failure::input(format!("--g must be positive, not {g}")));
-    }
-    // Windows are --window wide every --step (and rows every --row): a step far below
-    // them only multiplies the windows (issue 16: --step 1e-9 aborted on allocation).
-    if step < 1e-3 * window || row < 1e-3 * window {
-        return Err(Failure::input(format!(
-            "--step ({step}) and --row ({row}) must be at least a thousandth of --window \
-             ({window}): windows that close only repeat each other"
-        )));
-    }
-    let input = analyze::input::load(path, g)?;
-    let dir = out.unwrap_or_else(|| beside(path, "analysis"));
-    let opt = analyze::Options {
-        window,
-        step,
-        row,
-        fit_from: fit[0],
-        fit_to: fit[1],
-        ..Default::default()
-    };
-    let mut earlier = Vec::new();
-    if let Some(t) = from {
-        if !path.is_dir() {
-            return Err(Failure::input(
-                "--from needs a run folder (it averages the run's snapshots)",
-            ));
-        }
-        for p in analyze::input::snapshots_from(path, t)? {
-            let e = analyze::input::load(&p, g)?;
-            if e.step < input.step {
-                earlier.push(e);
-            }
-        }
-    }
-    let a = analyze::analyze_series(input, earlier, &opt)?;
-    if a.summary.averaged_snapshots > 1 {
-        out!(
-            "stresses averaged over {} snapshots from t = {}",
-            a.summary.averaged_snapshots,
-            a.summary.averaged_from_time
-        );
-    }
-    let files = analyze::write(&a, &dir)?;
-    let s = &a.summary;
-    let o = &s.outline;
-    out!(
-        "{}: {} grains at t = {}; heap {:.4} high, {:.4} wide ({})",
-        s.scene,
-        s.grains,
-        s.time,
-        o.height,
-        o.width,
-        a.input.length_unit
-    );
-    out!(
-        "angle of repose: left {}, right {}",
-        s.repose_left,
-        s.repose_right
-    );
-    let r = &s.repose_readings;
-    out!(
-        "  read other ways (left / right): middle third of the height {} / {}, apex to toe {} / {}, steepest stretch {} / {}",
-        degrees(r.middle[0].angle_deg),
-        degrees(r.middle[1].angle_deg),
-        degrees(r.apex_toe[0].angle_deg),
-        degrees(r.apex_toe[1].angle_deg),
-        degrees(r.steepest[0].angle_deg),
-        degrees(r.steepest[1].angle_deg)
-    );
-    out!(
-        "coordination: {:.3} all, {:.3} without {} rattlers, {:.3} interior; packing fraction {:.3} (lower half)",
-        s.coordination.all,
-        s.coordination.without_rattlers,
-        s.coordination.rattlers,
-        s.coordination.interior,
-        s.packing_fraction_lower_half
-    );
-    if let Some(j) = &s.janssen {
-        out!(
-            "mean stress against depth (stress_depth.csv): Janssen fit sigma_xx + sigma_zz = sigma_m (1 - exp(-x/h_s)) with sigma_m = {:.3} rho g W, h_s = {:.2} W (slabs to {:.2} W deep)",
-            j.sigma_m,
-            j.h_s,
-            a.stress_depth.last().map_or(0.0, |p| p.0)
-        );
-    }
-    if let Some(b) = &s.base_load {
-        let (mg, sp) = (b.grain_weight, &b.spread);
-        out!(
-            "base load over {} base particles, in m g (bootstrap se of {} replicas): centre {:.2} ± {:.2}, side maxima {:.2} ± {:.2} (left) and {:.2} ± {:.2} (right)",
-            analyze::BASE_SPAN,
-            sp.bootstrap_replicas,
-            b.centre / mg,
-            sp.centre_se / mg,
-            b.left_max / mg,
-            sp.left_max_se / mg,
-            b.right_max / mg,
-            sp.right_max_se / mg
-        );
-        out!(
-            "dip D = mean side maximum - centre = {:.2} ± {:.2} m g; noise on a plateau gives {:.2} ± {:.2}: z = {:.2}, p = {:.3}: {}",
-            sp.dip / mg,
-            sp.dip_se / mg,
-            sp.dip_null / mg,
-            sp.dip_null_sd / mg,
-            sp.dip_z,
-            sp.dip_p,
-            sp.verdict
-        );
-    }
-    out!("wrote {} files to {}", files.len(), dir.display());
-    Ok(())
-}
-
-fn cmd_render(
-    path: &std::path::Path,
-    out: Option<PathBuf>,
-    color: talus::render::Field,
-    width: u32,
-    window: f64,
-    g: Option<f64>,
-) -> Result<(), Failure> {
-    if !(16..=20_000).contains(&width) {
-        return Err(Failure::input(format!(
-            "--width must be between 16 and 20000 pixels, not {width}"
-        )));
-    }
-    if !(window.is_finite() && window > 0.0) {
-        return Err(Failure::input(format!(
-            "--window must be a positive number of diameters, not {window}"
-        )));
-    }
-    let dir = out.unwrap_or_else(|| beside(path, "pictures"));
-    let input = talus::analyze::input::load(path, g)?;
-    let opt = talus::analyze::Options {
-        window,
-        ..Default::default()
-    };
-    let a = talus::analyze::analyze(input, &opt)?;
-    let mut files = talus::render::render(&a, &dir, color, width)?;
-    files.extend(talus::render::vtk::write(&a, &dir)?);
-    out!("wrote {} files to {}", files.len(), dir.display());
-    Ok(())
-}
-
-/// Whether `dir` holds a finished run (its `summary.json` is written last) of exactly
-/// `scene`.
-fn finished_run_of(dir: &std::path::Path, scene: &scene::Scene) -> bool {
-    let read = |name: &str| -> Option<serde_json::Value> {
-        serde_json::from_str(&std::fs::read_to_string(dir.join(name)).ok()?).ok()
-    };
-    read("summary.json").is_some()
-        && read("scene.json").is_some_and(|s| serde_json::to_value(scene).ok() == Some(s))
-}
-
-/// `--full` and `--rods` as one size (clap refuses both at once).
-fn reproduction_size(full: bool, rods: Option<usize>) -> talus::reproduce::Size {
-    use talus::reproduce::Size;
-    match (rods, full) {
-        (Some(n), _) => Size::Rods(n),
-        (None, true) => Size::Full,
-        (None, false) => Size::Reduced,
-    }
-}
-
-/// The variants of reproduction `id` that `only` picks (`reproduce::pick`), if given.
-fn chosen_variants(
-    id: &str,
-    size: talus::reproduce::Size,
-    only: Option<&str>,
-) -> Result<Vec<talus::reproduce::Variant>, Failure> {
-    let mut variants = talus::reproduce::variants(id, size)?;
-    if let Some(only) = only {
-        let names: Vec<String> = variants.iter().map(|v| v.name.clone()).collect();
-        variants = talus::reproduce::pick(variants, only);
-        if variants.is_empty() {
-            return Err(Failure::input(format!(
-                "--only {only}: no variant of {id} matches; they are {}",
-                names.join(", ")
-            )));
-        }
-    }
-    Ok(variants)
-}
-
 /// An angle in degrees for a summary line, or "none" where there was nothing to fit
 /// (a box deposit has no free slope).
 fn degrees(a: f64) -> String {
@@ -652,225 +447,6 @@ fn degrees(a: f64) -> String {
     } else {
         "none".to_string()
     }
-}
-
-fn cmd_reproduce(
-    id: &str,
-    size: talus::reproduce::Size,
-    only: Option<&str>,
-    reuse: bool,
-    out: Option<PathBuf>,
-    backend: Backend,
-    quiet: bool,
-) -> Result<(), Failure> {
-    use talus::reproduce;
-    let id = id.to_uppercase();
-    let variants = chosen_variants(&id, size, only)?;
-    let root = out.unwrap_or_else(|| PathBuf::from("runs/reproduce").join(&id));
-    let interrupt = on_interrupt();
-    let mut found = Vec::new();
-    let mut failed = Vec::new();
-    for v in &variants {
-        if interrupt.load(Ordering::Relaxed) {
-            return Err(Failure::interrupted(format!(
-                "{id}: interrupted before {}",
-                v.name
-            )));
-        }
-        let within = |e| Failure::from(e).within(format!("{id} {}", v.name));
-        let scene = scene::parse(v.scene, &v.overrides).map_err(within)?;
-        let sim = Simulation::new(scene).map_err(within)?;
-        let dir = root.join(&v.name);
-        let finished = reuse && finished_run_of(&dir, &sim.scene);
-        if !quiet {
-            let how = if finished {
-                " (finished run reused)"
-            } else {
-                ""
-            };
-            eprintln!(
-                "{id} {}: {} -> {}{how}",
-                v.name,
-                sim.scene.name,
-                dir.display()
-            );
-        }
-        if finished {
-            // Measured and drawn below like a fresh run.
-        } else if let Err(e) = run::run(
-            &mut choose_engine(checkpoint::Checkpoint::fresh(sim), backend, quiet)?,
-            &run::RunOptions {
-                out: dir.clone(),
-                quiet,
-                // A variant's folder is this reproduction's own: run again, it replaces
-                // the run there (--reuse keeps a finished one instead).
-                force: true,
-                resumed_from: None,
-                interrupt: interrupt.clone(),
-                ..Default::default()
-            },
-        ) {
-            if let run::RunError::Interrupted { .. } = e {
-                return Err(Failure::from(e).within(format!("{id} {}", v.name)));
-            }
-            // A variant that fails is reported and the others still run.
-            eprintln!("error: {id} {}: {e}", v.name);
-            failed.push(serde_json::json!({ "variant": v.name, "error": e.to_string() }));
-            continue;
-        }
-        let opt = talus::analyze::Options {
-            window: v.window,
-            row: v.row,
-            ..Default::default()
-        };
-        let input = talus::analyze::input::load(&dir, None)?;
-        let a = talus::analyze::analyze(input, &opt)?;
-        talus::analyze::write(&a, &dir.join("analysis"))?;
-        talus::render::render(
-            &a,
-            &dir.join("pictures"),
-            talus::render::Field::Pressure,
-            1600,
-        )?;
-        talus::render::vtk::write(&a, &dir.join("pictures"))?;
-        let f = reproduce::findings(&v.name, &a);
-        out!(
-            "{id} {}: {} grains, t = {:.3}; repose {} / {}; S_xx/S_zz (row 1, interior) {:.3}; S_zz under the apex / max: base {:.3} / {:.3} (dip {:.2}), row 1 {:.3} / {:.3} (dip {:.2}); Z interior {:.2}",
-            v.name,
-            f.grains,
-            f.time,
-            degrees(f.repose_left_deg),
-            degrees(f.repose_right_deg),
-            f.stress_ratio_interior_row1,
-            f.base_szz_centre,
-            f.base_szz_max,
-            f.base_dip,
-            f.row1_szz_centre,
-            f.row1_szz_max,
-            f.row1_dip,
-            f.coordination_interior
-        );
-        if let (Some(c), Some(l), Some(r)) = (
-            f.base_load_centre_mg,
-            f.base_load_left_max_mg,
-            f.base_load_right_max_mg,
-        ) {
-            out!(
-                "{id} {}: load on the base particles (over {} of them) under the apex {c:.2} m g, largest left {l:.2}, right {r:.2}",
-                v.name,
-                talus::analyze::BASE_SPAN
-            );
-        }
-        found.push(f);
-    }
-    let averages = reproduce::seed_averages(&found);
-    // Row-1 profiles side by side: the seed averages where there are seeds.
-    let profiles: Vec<(String, Vec<(f64, f64)>)> = if averages.is_empty() {
-        found
-            .iter()
-            .map(|f| (f.variant.clone(), f.row1_profile.clone()))
-            .collect()
-    } else {
-        averages
-            .iter()
-            .map(|a| {
-                (
-                    format!("{} ({} seeds)", a.setting, a.seeds),
-                    a.profile.clone(),
-                )
-            })
-            .collect()
-    };
-    if !profiles.is_empty() {
-        let path = root.join("profiles.svg");
-        talus::render::plots::write_profiles(
-            &path,
-            &format!("{id}: vertical stress in row 1"),
-            &profiles,
-        )?;
-    }
-    let deep: Vec<_> = (found.iter())
-        .filter(|f| f.stress_depth.len() >= 3)
-        .map(|f| (f.variant.clone(), f.stress_depth.clone(), f.janssen))
-        .collect();
-    if !deep.is_empty() {
-        let path = root.join("janssen.svg");
-        talus::render::plots::write_janssen(
-            &path,
-            &format!("{id}: mean stress against depth"),
-            &deep,
-        )?;
-    }
-    for a in &averages {
-        out!(
-            "{id} {} (average of {} seeds): S_zz(1) under the apex {:.3}, max {:.3}, dip {:.2}; Z interior {:.2}",
-            a.setting,
-            a.seeds,
-            a.row1_szz_apex,
-            a.row1_szz_max,
-            a.row1_dip,
-            a.coordination_interior
-        );
-    }
-    let trends = if id == "R9" {
-        reproduce::r9_trends(&found)
-    } else {
-        Vec::new()
-    };
-    for t in &trends {
-        out!("{id}: {t}");
-    }
-    let comparisons = reproduce::comparisons(&id, &found);
-    for c in &comparisons {
-        out!(
-            "{id} {} against {}: row-1 S_zz differs by {:.3} of the maximum at most, {:.3} on average",
-            c.variants[0],
-            c.variants[1],
-            c.row1_szz_max_difference,
-            c.row1_szz_mean_difference
-        );
-    }
-    let report = serde_json::json!({
-        "id": id,
-        "full": size != reproduce::Size::Reduced,
-        "size": size,
-        "claim": reproduce::claim(&id),
-        "seed_averages": averages,
-        "comparisons": comparisons,
-        "trends": trends,
-        "variants": found,
-        "failed": failed,
-    });
-    finish_reproduction(&id, &root, &report, failed.len(), variants.len(), "failed")
-}
-
-/// Writes `root/reproduce.json`, says where the results are, and fails when `failed` of
-/// the `of` variants `what` (failed, or had failed runs).
-fn finish_reproduction(
-    id: &str,
-    root: &std::path::Path,
-    report: &serde_json::Value,
-    failed: usize,
-    of: usize,
-    what: &str,
-) -> Result<(), Failure> {
-    let path = root.join("reproduce.json");
-    talus::files::write_atomic(
-        &path,
-        serde_json::to_string_pretty(report).unwrap().as_bytes(),
-    )
-    .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
-    out!(
-        "{id}: {}; results in {}",
-        talus::reproduce::claim(id),
-        root.display()
-    );
-    if failed > 0 {
-        return Err(Failure::failed(format!(
-            "{id}: {failed} of {of} variants {what} (listed in reproduce.json)"
-        )));
-    }
-    Ok(())
 }
 
 fn cmd_run(

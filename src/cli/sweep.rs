@@ -573,7 +573,7 @@ pub fn reproduce(
 ) -> Result<(), Failure> {
     use talus::reproduce;
     let id = id.to_uppercase();
-    let variants = super::chosen_variants(&id, size, only)?;
+    let variants = super::reproduce::chosen_variants(&id, size, only)?;
     let list = sweep::parse_seeds(&seeds.seeds)?;
     if seeds.jobs == Some(0) {
         return Err(Failure::input("--jobs: must be at least 1, got 0"));
@@ -688,7 +688,7 @@ pub fn reproduce(
         "variants": statistics,
         "failed": failed,
     });
-    super::finish_reproduction(
+    super::reproduce::finish_reproduction(
         &id,
         &root,
         &report,

@@ -8,15 +8,20 @@
 mod contact;
 mod overrides;
 mod schema;
+mod stability;
 mod strict;
 mod validate;
 
 pub use contact::*;
 pub use overrides::apply_override;
 pub use schema::*;
+pub use stability::{
+    DAMPING_STABILITY, IMPACT_DAMPING_STABILITY, MIN_STEPS_PER_CONTACT,
+    RECOMMENDED_STEPS_PER_CONTACT, shortest_contact_time,
+};
 pub use validate::{
-    material_of, max_diameter, polygon_of, reach_bound_of, shortest_contact_time,
-    smallest_particle_area, typical_masses, validate,
+    material_of, max_diameter, polygon_of, reach_bound_of, smallest_particle_area, typical_masses,
+    validate,
 };
 
 /// Non-fatal remarks about a valid scene (e.g. dt above t_c/10).
