@@ -623,36 +623,40 @@ pub fn reproduce(
         let Some(point) = c.points.first() else {
             continue;
         };
-        let stat = |name: &str| point.stats.iter().find(|s| s.0 == name).map(|s| s.1);
-        let show = |name: &str, unit: &str| {
-            stat(name).map_or(String::new(), |s| {
-                format!(
-                    "{:.3}{unit} ± {:.3} (se {:.3}, n {})",
-                    s.mean, s.std, s.se, s.n
-                )
-            })
-        };
-        out!(
-            "{id} {} ({} of {} seeds measured): repose left {}, right {}, mean {} (middle third {}, apex to toe {}, steepest stretch {}); height {} d; packing {}; Z interior {}; S_zz(1) apex {} max {}; base load centre {} side max {} m g, ratio {}, dip above noise {} m g",
-            v.name,
-            point.measured,
-            point.runs,
-            show("repose_left_deg", "°"),
-            show("repose_right_deg", "°"),
-            show("repose_mean_deg", "°"),
-            show("repose_middle_deg", "°"),
-            show("repose_apex_toe_deg", "°"),
-            show("repose_steepest_deg", "°"),
-            show("height_d", ""),
-            show("packing_fraction_lower_half", ""),
-            show("coordination_interior", ""),
-            show("row1_szz_centre", ""),
-            show("row1_szz_max", ""),
-            show("base_load_centre_mg", ""),
-            show("base_load_side_max_mg", ""),
-            show("base_load_centre_over_side_max", ""),
-            show("base_load_dip_excess_mg", "")
-        );
+        if point.measured == 0 {
+            out!("{id} {}: none of {} seeds measured", v.name, point.runs);
+        } else {
+            let stat = |name: &str| point.stats.iter().find(|s| s.0 == name).map(|s| s.1);
+            let show = |name: &str, unit: &str| {
+                stat(name).map_or(String::new(), |s| {
+                    format!(
+                        "{:.3}{unit} ± {:.3} (se {:.3}, n {})",
+                        s.mean, s.std, s.se, s.n
+                    )
+                })
+            };
+            out!(
+                "{id} {} ({} of {} seeds measured): repose left {}, right {}, mean {} (middle third {}, apex to toe {}, steepest stretch {}); height {} d; packing {}; Z interior {}; S_zz(1) apex {} max {}; base load centre {} side max {} m g, ratio {}, dip above noise {} m g",
+                v.name,
+                point.measured,
+                point.runs,
+                show("repose_left_deg", "°"),
+                show("repose_right_deg", "°"),
+                show("repose_mean_deg", "°"),
+                show("repose_middle_deg", "°"),
+                show("repose_apex_toe_deg", "°"),
+                show("repose_steepest_deg", "°"),
+                show("height_d", ""),
+                show("packing_fraction_lower_half", ""),
+                show("coordination_interior", ""),
+                show("row1_szz_centre", ""),
+                show("row1_szz_max", ""),
+                show("base_load_centre_mg", ""),
+                show("base_load_side_max_mg", ""),
+                show("base_load_centre_over_side_max", ""),
+                show("base_load_dip_excess_mg", "")
+            );
+        }
         if let Some((_, profile)) = point.profiles.iter().find(|p| p.0 == "szz_row1")
             && !profile.is_empty()
         {
