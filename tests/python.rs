@@ -1,0 +1,216 @@
+//! The Python reader (`python/talus`, issue 41 item 1) against the Rust one: a run
+//! written by `talus run`, read back by both, value for value. Needs a Python 3 with
+//! numpy (`TALUS_PYTHON`, else `python3`, else `/usr/bin/python3`); without one the
+//! tests say so and pass, unless `TALUS_REQUIRE_PYTHON=1` (set by `.ci/run`, whose
+//! `scripts/test` installs `python3-numpy`).
+
+mod common;
+
+use serde_json::{Value, json};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use talus::snapshot;
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("talus-python-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A Python 3 that imports numpy, or None (with a message) where there is none and
+/// none is required.
+fn python() -> Option<PathBuf> {
+    let candidates = std::env::var_os("TALUS_PYTHON")
+        .map(PathBuf::from)
+        .into_iter()
+        .chain(["python3", "/usr/bin/python3"].map(PathBuf::from));
+    for p in candidates {
+        let ok = Command::new(&p)
+            .args(["-c", "import numpy"])
+            .output()
+            .is_ok_and(|o| o.status.success());
+        if ok {
+            return Some(p);
+        }
+    }
+    if std::env::var("TALUS_REQUIRE_PYTHON").as_deref() == Ok("1") {
+        panic!("no Python 3 with numpy (TALUS_REQUIRE_PYTHON=1): apt-get install python3-numpy");
+    }
+    eprintln!(
+        "skipped: no Python 3 with numpy (set TALUS_PYTHON, or apt-get install python3-numpy)"
+    );
+    None
+}
+
+/// Runs `code` with the reader importable (`PYTHONPATH=python`) in `cwd`; its stdout
+/// as JSON, or its stderr as the error.
+fn run_python(py: &Path, code: &str, cwd: &Path) -> Result<Value, String> {
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let o = Command::new(py)
+        .args(["-c", code])
+        .env("PYTHONPATH", repo.join("python"))
+        .current_dir(cwd)
+        .output()
+        .unwrap();
+    if !o.status.success() {
+        return Err(String::from_utf8_lossy(&o.stderr).into_owned());
+    }
+    Ok(serde_json::from_slice(&o.stdout).expect("the script prints JSON"))
+}
+
+/// `talus run` of a small pile: disks in a row on a floor and a pentagon falling onto
+/// them, with snapshots; the run folder `DIR/run`.
+fn small_run(dir: &Path) -> PathBuf {
+    let row: Vec<_> = (0..8)
+        .map(|k| json!({ "position": [k as f64 * 0.99, 0.499], "diameter": 1.0 }))
+        .collect();
+    let mut v = common::scene_value(
+        json!({ "law": "overlap_area", "k_n": 1e4, "mu": 0.5 }),
+        json!([{ "kind": "list", "material": "m", "particles": row },
+               { "kind": "list", "material": "m", "polygon": { "corners": 5 },
+                 "particles": [{ "position": [2.0, 1.6], "theta": 0.3, "diameter": 1.0 }] }]),
+    );
+    v["name"] = json!("python-reader");
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-5.0, 0.0], "to": [15.0, 0.0] }]);
+    v["stop"] = json!({ "time": 0.05 });
+    v["output"] = json!({ "snapshot_every": 0.02, "log_every": 0.01, "checkpoint_every": 0 });
+    let scene = dir.join("scene.json");
+    std::fs::write(&scene, v.to_string()).unwrap();
+    let out = dir.join("run");
+    let o = Command::new(common::talus_bin())
+        .args(["run", "-q", "--backend", "cpu", "--out"])
+        .arg(&out)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    out
+}
+
+const READ: &str = r#"
+import json, sys, talus
+run = talus.read_run("run")
+s = run["final"]
+c = s["contacts"]
+print(json.dumps({
+    "times": run["snapshots"].times.tolist(),
+    "log_time": run["log"]["time"].tolist(),
+    "summary_time": run["summary"]["time"],
+    "time": s["time"], "step": s["step"],
+    "id": s["id"].tolist(), "position": s["position"].tolist(),
+    "velocity": s["velocity"].tolist(), "angle": s["angle"].tolist(),
+    "angular_velocity": s["angular_velocity"].tolist(), "radius": s["radius"].tolist(),
+    "fixed": s["fixed"].tolist(), "corners": s["corners"].tolist(),
+    "vertices": [v.tolist() for v in s["vertices"]],
+    "i": c["i"].tolist(), "j": c["j"].tolist(), "force": c["force"].tolist(),
+    "point": c["point"].tolist(), "overlap": c["overlap"].tolist(),
+}))
+"#;
+
+#[test]
+fn the_python_reader_reads_what_the_rust_one_reads() {
+    let Some(py) = python() else { return };
+    let dir = tmp("run");
+    let run = small_run(&dir);
+    // From the run's parent folder, with a relative path: the data is found beside
+    // the metadata, not in the working directory.
+    let got = run_python(&py, READ, &dir).unwrap_or_else(|e| panic!("{e}"));
+    let s = snapshot::read(&run.join("final.json")).unwrap();
+    let f = |k: &str| s.f64(&format!("particles.{k}")).unwrap().to_vec();
+    let list = |v: &Value| -> Vec<f64> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_f64().unwrap())
+            .collect()
+    };
+    let pairs = |v: &Value| -> Vec<[f64; 2]> {
+        (v.as_array().unwrap().iter())
+            .map(|p| [p[0].as_f64().unwrap(), p[1].as_f64().unwrap()])
+            .collect()
+    };
+    let zip = |a: Vec<f64>, b: Vec<f64>| -> Vec<[f64; 2]> {
+        a.into_iter().zip(b).map(|(a, b)| [a, b]).collect()
+    };
+    // The particle table, bit for bit (JSON carries every f64 exactly).
+    assert_eq!(got["time"].as_f64(), Some(s.meta.time));
+    assert_eq!(got["step"].as_u64(), Some(s.meta.step));
+    let ids: Vec<u64> = (s.u32("particles.id").unwrap().iter())
+        .map(|&i| i as u64)
+        .collect();
+    assert_eq!(got["id"], json!(ids));
+    assert_eq!(pairs(&got["position"]), zip(f("x"), f("z")));
+    assert_eq!(pairs(&got["velocity"]), zip(f("vx"), f("vz")));
+    assert_eq!(list(&got["angle"]), f("theta"));
+    assert_eq!(list(&got["angular_velocity"]), f("omega"));
+    assert_eq!(list(&got["radius"]), f("radius"));
+    assert_eq!(got["corners"], json!([0, 0, 0, 0, 0, 0, 0, 0, 5]));
+    assert_eq!(got["fixed"].as_array().unwrap().len(), 9);
+    // The pentagon's corners in the world frame: (x, z) + R(θ) v, each at the
+    // circumscribed radius from the centre.
+    let (cx, cz) = (s.f64("corners.x").unwrap(), s.f64("corners.z").unwrap());
+    let (p, theta) = ([f("x")[8], f("z")[8]], f("theta")[8]);
+    let corners = got["vertices"][8].as_array().unwrap();
+    assert_eq!(corners.len(), 5);
+    for (k, c) in corners.iter().enumerate() {
+        let (sn, cs) = theta.sin_cos();
+        let want = [
+            p[0] + cs * cx[k] - sn * cz[k],
+            p[1] + sn * cx[k] + cs * cz[k],
+        ];
+        let c = [c[0].as_f64().unwrap(), c[1].as_f64().unwrap()];
+        assert!(
+            (c[0] - want[0]).abs() < 1e-14 && (c[1] - want[1]).abs() < 1e-14,
+            "corner {k}: {c:?} against {want:?}"
+        );
+    }
+    assert!(
+        got["vertices"][0].as_array().unwrap().is_empty(),
+        "a disk has none"
+    );
+    // The contacts: ids, the force on i as fn n + ft t (t = (−n_z, n_x)), the points.
+    let cf = |k: &str| s.f64(&format!("contacts.{k}")).unwrap().to_vec();
+    assert!(!cf("fn").is_empty(), "the pile has contacts");
+    let i: Vec<u64> = (s.u32("contacts.i").unwrap().iter())
+        .map(|&i| i as u64)
+        .collect();
+    assert_eq!(got["i"], json!(i));
+    let (nx, nz, fnn, ft) = (cf("nx"), cf("nz"), cf("fn"), cf("ft"));
+    for (k, force) in pairs(&got["force"]).into_iter().enumerate() {
+        let want = [
+            fnn[k] * nx[k] - ft[k] * nz[k],
+            fnn[k] * nz[k] + ft[k] * nx[k],
+        ];
+        assert_eq!(force, want, "contact {k}");
+    }
+    assert_eq!(pairs(&got["point"]), zip(cf("px"), cf("pz")));
+    assert_eq!(list(&got["overlap"]), cf("overlap"));
+    // The run: snapshots in time order (t = 0, 0.02, 0.04), the log, the summary.
+    let times = list(&got["times"]);
+    assert_eq!(times.len(), 3, "{times:?}");
+    assert!(times.windows(2).all(|w| w[0] < w[1]), "{times:?}");
+    assert!(list(&got["log_time"]).len() >= 4);
+    assert_eq!(got["summary_time"].as_f64(), Some(s.meta.time));
+}
+
+#[test]
+fn the_python_reader_refuses_a_damaged_snapshot() {
+    let Some(py) = python() else { return };
+    let dir = tmp("damaged");
+    let run = small_run(&dir);
+    let bin = run.join("final.bin");
+    let mut b = std::fs::read(&bin).unwrap();
+    b[17] ^= 0x10;
+    std::fs::write(&bin, &b).unwrap();
+    let code = "import talus\ntalus.read_snapshot('run/final.json')";
+    let err = run_python(&py, code, &dir).expect_err("a damaged snapshot reads");
+    assert!(
+        err.contains("SnapshotError") && err.contains("damaged"),
+        "{err}"
+    );
+    // Unchecked on request: the data as it stands.
+    let code = "import json, talus\nprint(json.dumps(len(talus.read_snapshot('run/final.json', verify=False)['id'])))";
+    assert_eq!(run_python(&py, code, &dir).unwrap(), json!(9));
+}
