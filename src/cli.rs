@@ -36,7 +36,7 @@ use talus::{bench, checkpoint, run, scene, sim::Simulation};
 #[derive(Parser)]
 #[command(
     name = "talus",
-    version,
+    version = talus::provenance::VERSION_LINE,
     about = "2D granular dynamics (DEM) of heaps and packings"
 )]
 struct Cli {

@@ -24,6 +24,7 @@ pub mod neighbours;
 pub mod overlap;
 pub mod parallel;
 pub mod progress;
+pub mod provenance;
 pub mod render;
 pub mod reproduce;
 pub mod rng;

@@ -43,6 +43,10 @@ pub struct Meta {
     pub wall_base: u32,
     pub data: String,
     pub columns: Vec<ColumnMeta>,
+    /// What wrote it (since issue 41; absent in older snapshots and in one captured in
+    /// memory).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub provenance: Option<crate::provenance::Provenance>,
     /// "fnv1a64:" and 16 hex digits: FNV-1a over the `.bin` and then this metadata
     /// without the checksum, as compact JSON (`digest`). A snapshot in memory has none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -109,6 +113,18 @@ impl Builder {
 /// Writes `DIR/STEM.bin` and `DIR/STEM.json`; returns the JSON path.
 pub fn write(sim: &Simulation, dir: &Path, stem: &str) -> std::io::Result<PathBuf> {
     capture(sim, stem).write(dir, stem)
+}
+
+/// `write`, the metadata saying what wrote it (a run's snapshots).
+pub fn write_with(
+    sim: &Simulation,
+    dir: &Path,
+    stem: &str,
+    provenance: &crate::provenance::Provenance,
+) -> std::io::Result<PathBuf> {
+    let mut snap = capture(sim, stem);
+    snap.meta.provenance = Some(provenance.clone());
+    snap.write(dir, stem)
 }
 
 /// The snapshot of the state in memory, as `read` would give it back once written
@@ -229,6 +245,7 @@ pub fn capture(sim: &Simulation, stem: &str) -> Snapshot {
         wall_base: WALL_BASE,
         data: format!("{stem}.bin"),
         columns: b.meta,
+        provenance: None,
         checksum: None,
     };
     Snapshot {

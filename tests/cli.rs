@@ -528,7 +528,105 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
     ]);
     assert_eq!(code, 0, "{err}");
     let log_after = std::fs::read_to_string(first.join("log.csv")).unwrap();
-    assert_eq!(log_after, log_before, "a bitwise resume logs the same rows");
+    let rows = |log: &str| -> Vec<String> {
+        (log.lines())
+            .filter(|l| !l.starts_with('#'))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(
+        rows(&log_after),
+        rows(&log_before),
+        "a bitwise resume logs the same rows"
+    );
+    // Its head names both runs that wrote it, the first and the resumed one.
+    let head: Vec<&str> = log_after
+        .lines()
+        .take_while(|l| l.starts_with('#'))
+        .collect();
+    assert_eq!(head.len(), 2, "{head:?}");
+    assert!(
+        head[0].contains("stop.time=4") && head[1].contains("--resume"),
+        "{head:?}"
+    );
+}
+
+#[test]
+fn every_output_says_what_wrote_it() {
+    // Issue 41 item 3: talus --version names the commit; a run's summary.json, its
+    // snapshots and its log carry the version, the commit, the command line, the
+    // threads and the backend.
+    let (code, version, err) = talus(&["--version"]);
+    assert_eq!(code, 0, "{err}");
+    let commit = talus::provenance::COMMIT;
+    assert_eq!(
+        version.trim(),
+        format!("talus {} (commit {commit})", env!("CARGO_PKG_VERSION"))
+    );
+    let git = std::process::Command::new("git")
+        .args(["rev-parse", "--short=12", "HEAD"])
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output();
+    if let Ok(o) = git
+        && o.status.success()
+    {
+        // Built from this checkout (a commit made since needs a rebuild, which cargo
+        // test does: build.rs watches HEAD).
+        assert_eq!(commit, String::from_utf8_lossy(&o.stdout).trim());
+    }
+    let out = tmp("provenance");
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--threads",
+        "1",
+        "--backend",
+        "cpu",
+        "--out",
+        out.to_str().unwrap(),
+        "--set",
+        "stop.time=0.2",
+        "--set",
+        "output.snapshot_every=0.1",
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let read = |p: &str| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(out.join(p)).unwrap()).unwrap()
+    };
+    let snapshot = std::fs::read_dir(out.join("snapshots"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "json"))
+        .unwrap();
+    let snap: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(snapshot).unwrap()).unwrap();
+    for (what, p) in [
+        ("summary.json", read("summary.json")["provenance"].clone()),
+        ("final.json", read("final.json")["provenance"].clone()),
+        ("a snapshot", snap["provenance"].clone()),
+    ] {
+        assert_eq!(p["version"], env!("CARGO_PKG_VERSION"), "{what}: {p}");
+        assert_eq!(p["commit"], commit, "{what}: {p}");
+        assert_eq!(p["threads"], 1, "{what}: {p}");
+        assert_eq!(p["backend"], "cpu", "{what}: {p}");
+        let line: Vec<&str> = (p["command_line"].as_array().unwrap().iter())
+            .map(|a| a.as_str().unwrap())
+            .collect();
+        assert_eq!(&line[1..3], ["run", "-q"], "{what}: {p}");
+        assert!(line.contains(&"stop.time=0.2"), "{what}: {p}");
+    }
+    // The snapshots still read (the checksum covers the provenance too).
+    talus::snapshot::read(&out.join("final.json")).unwrap();
+    let log = std::fs::read_to_string(out.join("log.csv")).unwrap();
+    let first = log.lines().next().unwrap();
+    assert!(
+        first.starts_with(&format!(
+            "# talus {} (commit {commit}), backend cpu, 1 thread: ",
+            env!("CARGO_PKG_VERSION")
+        )) && first.contains("stop.time=0.2"),
+        "{first}"
+    );
+    assert!(log.lines().nth(1).unwrap().starts_with("step,time,"));
 }
 
 #[test]

@@ -98,7 +98,7 @@ print(json.dumps({
     "times": run["snapshots"].times.tolist(),
     "log_time": run["log"]["time"].tolist(),
     "summary_time": run["summary"]["time"],
-    "time": s["time"], "step": s["step"],
+    "time": s["time"], "step": s["step"], "provenance": s["provenance"],
     "id": s["id"].tolist(), "position": s["position"].tolist(),
     "velocity": s["velocity"].tolist(), "angle": s["angle"].tolist(),
     "angular_velocity": s["angular_velocity"].tolist(), "radius": s["radius"].tolist(),
@@ -137,6 +137,8 @@ fn the_python_reader_reads_what_the_rust_one_reads() {
     // The particle table, bit for bit (JSON carries every f64 exactly).
     assert_eq!(got["time"].as_f64(), Some(s.meta.time));
     assert_eq!(got["step"].as_u64(), Some(s.meta.step));
+    assert_eq!(got["provenance"], json!(s.meta.provenance), "what wrote it");
+    assert_eq!(got["provenance"]["commit"], talus::provenance::COMMIT);
     let ids: Vec<u64> = (s.u32("particles.id").unwrap().iter())
         .map(|&i| i as u64)
         .collect();

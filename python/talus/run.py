@@ -11,12 +11,16 @@ from .snapshot import SnapshotError, read_snapshot, _metadata
 
 
 def read_log(path):
-    """`log.csv` as a dict of numpy arrays, one per column (`step`, `time`, energies)."""
+    """`log.csv` as a dict of numpy arrays, one per column (`step`, `time`, energies);
+    the `#` lines at its head (which talus runs wrote it) are skipped."""
     path = os.fspath(path)
     if os.path.isdir(path):
         path = os.path.join(path, "log.csv")
     with open(path, encoding="utf-8") as f:
-        header = f.readline().strip().split(",")
+        line = f.readline()
+        while line.startswith("#"):  # the runs that wrote it (talus's provenance)
+            line = f.readline()
+        header = line.strip().split(",")
         rows = np.loadtxt(f, delimiter=",", ndmin=2)
     if rows.size == 0:
         rows = np.zeros((0, len(header)))

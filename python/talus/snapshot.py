@@ -122,8 +122,9 @@ def read_snapshot(path, verify=True):
     - `contacts`: `i`, `j` (ids; `j >= wall_base` is wall `j - wall_base`), `normal`
       (M, 2) from j to i, `normal_force`, `tangential_force`, `force` (M, 2) on i,
       `point` (M, 2), `overlap`;
-    - `time`, `step`, `scene`, `units`, `wall_base`, and `columns` (every column by its
-      `table.name` key).
+    - `time`, `step`, `scene`, `units`, `wall_base`, `provenance` (what wrote it: version,
+      commit, command line, threads, backend; None in older snapshots), and `columns`
+      (every column by its `table.name` key).
     """
     meta, col = read_columns(path, verify)
 
@@ -153,6 +154,7 @@ def read_snapshot(path, verify=True):
         "scene": meta["scene"],
         "units": meta["units"],
         "wall_base": meta["wall_base"],
+        "provenance": meta.get("provenance"),
         "id": get("particles.id"),
         "position": position,
         "velocity": pair("particles.vx", "particles.vz"),

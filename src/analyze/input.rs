@@ -136,7 +136,8 @@ fn run_folder(snapshot: &Path) -> Option<PathBuf> {
 
 fn read_log(path: &Path) -> Option<(Vec<String>, Vec<Vec<f64>>)> {
     let text = std::fs::read_to_string(path).ok()?;
-    let mut lines = text.lines();
+    // The `#` lines at its head say which runs wrote it (issue 41).
+    let mut lines = text.lines().skip_while(|l| l.starts_with('#'));
     let header: Vec<String> = lines.next()?.split(',').map(str::to_string).collect();
     let rows = lines
         .filter(|l| !l.trim().is_empty())

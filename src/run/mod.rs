@@ -42,6 +42,8 @@ pub struct RunOptions {
 pub struct RunSummary {
     pub scene: String,
     pub backend: String,
+    /// talus's version and commit, the command line and the threads (issue 41).
+    pub provenance: crate::provenance::Provenance,
     pub steps: u64,
     pub time: f64,
     /// Active particles at the end, and of them the moving (not fixed) ones.
@@ -232,7 +234,8 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
     let text = serde_json::to_string_pretty(&scene).expect("a scene always serialises");
     write_atomic(&scene_path, text.as_bytes()).map_err(io(&scene_path))?;
 
-    let mut outputs = Outputs::new(&scene, out, start_step);
+    let provenance = crate::provenance::Provenance::here(&engine.name());
+    let mut outputs = Outputs::new(&scene, out, start_step, &provenance);
     let mut settling = Settling::new(&scene);
     // Progress between checks as well, so that the engine runs freely in between (on
     // the GPU: many steps per submission).
@@ -305,7 +308,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
     let backend = engine.name();
     outputs.write_end(engine)?;
     let sim = engine.sim()?;
-    let final_json = snapshot::write(sim, out, "final").map_err(io(out))?;
+    let final_json = snapshot::write_with(sim, out, "final", &provenance).map_err(io(out))?;
     let wall = start.elapsed().as_secs_f64();
     let e = sim.energies();
     let sources = sim.source_progress();
@@ -333,6 +336,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
     let summary = RunSummary {
         scene: sim.scene.name.clone(),
         backend,
+        provenance: provenance.clone(),
         steps: sim.step - start_step,
         time: sim.time(),
         particles: sim.particles.active_count(),
@@ -377,7 +381,8 @@ fn write_copies(
         let scene_path = dir.join("scene.json");
         let text = serde_json::to_string_pretty(&copy.scene).expect("a scene always serialises");
         write_atomic(&scene_path, text.as_bytes()).map_err(io(&scene_path))?;
-        let final_json = snapshot::write(&copy, &dir, "final").map_err(io(&dir))?;
+        let final_json =
+            snapshot::write_with(&copy, &dir, "final", &whole.provenance).map_err(io(&dir))?;
         let e = copy.energies();
         let summary = RunSummary {
             scene: copy.scene.name.clone(),

@@ -5,6 +5,7 @@
 use super::{Engine, RunError, io};
 use crate::files::write_atomic;
 use crate::progress::Progress;
+use crate::provenance::Provenance;
 use crate::scene::Scene;
 use crate::sim::Simulation;
 use crate::{analyze, checkpoint, render, snapshot};
@@ -60,7 +61,7 @@ pub struct Outputs {
 
 impl Outputs {
     /// The outputs of `scene` into run folder `out`, for a run starting at `start_step`.
-    pub fn new(scene: &Scene, out: &Path, start_step: u64) -> Self {
+    pub fn new(scene: &Scene, out: &Path, start_step: u64, provenance: &Provenance) -> Self {
         let (o, dt) = (&scene.output, scene.dt);
         let snapshots = Schedule::every(o.snapshot_every, dt);
         let checkpoints = Schedule::every(o.checkpoint_every.unwrap_or(0.1 * scene.stop.time), dt);
@@ -76,10 +77,12 @@ impl Outputs {
                 Schedule::every(log, dt),
                 checkpoints,
                 start_step,
+                provenance,
             ),
             snapshots: Snapshots {
                 every: snapshots,
                 dir: snap_dir.clone(),
+                provenance: provenance.clone(),
             },
             vtk: Vtk {
                 every: if o.vtk { snapshots } else { Schedule::NEVER },
@@ -151,7 +154,8 @@ impl Outputs {
 
 /// `log.csv`: a row of energies every `rows` steps, kept in memory and saved with every
 /// checkpoint (`saves`) and at the end, so that a resume from a checkpoint finds the
-/// log up to it.
+/// log up to it. Its head is a `#` line per run that wrote it (`Provenance::line`: a
+/// resumed run adds its own), then the column names.
 pub struct Log {
     rows: Schedule,
     saves: Schedule,
@@ -165,13 +169,28 @@ const LOG_HEADER: &str =
 impl Log {
     /// A resumed run (`start_step` > 0) continues the log of the run it resumes: its
     /// rows up to the start.
-    fn new(path: PathBuf, rows: Schedule, saves: Schedule, start_step: u64) -> Self {
-        let mut text = String::from(LOG_HEADER);
-        if start_step > 0
-            && let Ok(old) = std::fs::read_to_string(&path)
-            && old.starts_with(LOG_HEADER)
-        {
-            for line in old.lines().skip(1) {
+    fn new(
+        path: PathBuf,
+        rows: Schedule,
+        saves: Schedule,
+        start_step: u64,
+        provenance: &Provenance,
+    ) -> Self {
+        let old = if start_step > 0 {
+            std::fs::read_to_string(&path).unwrap_or_default()
+        } else {
+            String::new()
+        };
+        // The runs that wrote the log before this one, then this one.
+        let mut text: String = (old.lines())
+            .take_while(|l| l.starts_with('#'))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        text.push_str(&format!("# {}\n", provenance.line()));
+        text.push_str(LOG_HEADER);
+        let mut old_rows = old.lines().skip_while(|l| l.starts_with('#'));
+        if start_step > 0 && old_rows.next() == Some(LOG_HEADER.trim_end()) {
+            for line in old_rows {
                 match line.split(',').next().and_then(|s| s.parse::<u64>().ok()) {
                     Some(step) if step <= start_step => {
                         text.push_str(line);
@@ -231,6 +250,7 @@ impl Output for Log {
 pub struct Snapshots {
     every: Schedule,
     dir: PathBuf,
+    provenance: Provenance,
 }
 
 fn snapshot_stem(step: u64) -> String {
@@ -246,7 +266,8 @@ impl Output for Snapshots {
     }
     fn write(&mut self, engine: &mut Engine) -> Result<(), RunError> {
         let stem = snapshot_stem(engine.step());
-        snapshot::write(engine.sim()?, &self.dir, &stem).map_err(io(&self.dir))?;
+        snapshot::write_with(engine.sim()?, &self.dir, &stem, &self.provenance)
+            .map_err(io(&self.dir))?;
         Ok(())
     }
 }
