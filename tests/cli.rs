@@ -363,6 +363,28 @@ fn check_accepts_the_default_scene() {
     let (code, out, err) = talus(&["check"]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("81 particles at start (81 fixed)"), "{out}");
+    // And what its pour will add, and when (issue 41 item 7): 800 disks at 5 per time
+    // unit; with three copies, three times as many.
+    assert!(
+        out.contains("point source 0: 800 disks, 5 per time unit from t = 0 to t = 160")
+            && out.contains("created during the run: up to 800 particles, 881 in all"),
+        "{out}"
+    );
+    let (code, out, err) = talus(&["check", "--set", "replicas=3"]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("800 disks in each of the 3 copies")
+            && out.contains("up to 2400 particles, 2643 in all"),
+        "{out}"
+    );
+    // A layered pile: its rows, at most.
+    let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/r7_layered_medium.json");
+    let (code, out, err) = talus(&["check", scene]);
+    assert_eq!(code, 0, "{err}");
+    assert!(
+        out.contains("layered pile 0: at most ") && out.contains("a row every 1 s"),
+        "{out}"
+    );
 }
 
 #[test]

@@ -24,6 +24,9 @@ pub(super) fn cmd_check(
         run::total_steps(&sim),
         sim.dt()
     );
+    for line in what_creators_add(&sim) {
+        out!("{line}");
+    }
     let names: Vec<String> = sim.scene.materials.keys().cloned().collect();
     let lines = match &sim.law {
         talus::law::ContactLaw::SpringDashpot(l) => {
@@ -323,4 +326,65 @@ fn duration(seconds: f64) -> String {
         s if s < 172_800.0 => format!("{:.1} h", s / 3600.0),
         s => format!("{:.1} days", s / 86_400.0),
     }
+}
+
+/// What the scene's point sources and layered rows will add during the run, and when:
+/// a pour starts with no grains, and "0 particles at start" alone says nothing of it.
+fn what_creators_add(sim: &Simulation) -> Vec<String> {
+    let (sources, layered) = talus::sim::creators(&sim.scene);
+    let copies = sim.scene.replicas.max(1) as u64;
+    let each = if copies > 1 {
+        format!(" in each of the {copies} copies")
+    } else {
+        String::new()
+    };
+    let unit = if sim.scene.units == scene::Units::Si {
+        " s"
+    } else {
+        ""
+    };
+    let mut lines = Vec::new();
+    let mut total = 0u64;
+    for (k, s) in sources.iter().enumerate() {
+        let shape = if s.polygon.is_some() {
+            "polygons"
+        } else if s.rod.is_some() {
+            "rods"
+        } else {
+            "disks"
+        };
+        let end = s.start_time + s.count as f64 / s.rate;
+        let per = if unit.is_empty() { "time unit" } else { "s" };
+        lines.push(format!(
+            "point source {k}: {} {shape}{each}, {} per {per} from t = {}{unit} to t = {}{unit} \
+             (later while its spot at the outlet is taken), dropped from ({}, {}) ± {} in x",
+            s.count,
+            s.rate,
+            s.start_time,
+            (end * 1e4).round() / 1e4,
+            s.position[0],
+            s.position[1],
+            s.spread
+        ));
+        total += s.count as u64 * copies;
+    }
+    for (k, l) in layered.iter().enumerate() {
+        let rows = talus::create::layered::max_rows(l);
+        let most: u64 = (0..rows)
+            .map(|r| talus::create::layered::row_capacity(l, r) as u64)
+            .sum();
+        lines.push(format!(
+            "layered pile {k}: at most {rows} rows, {most} particles{each}, a row every {}{unit} from t = {}{unit} \
+             (each row where the pile is still below its {}° outline)",
+            l.interval, l.start_time, l.slope
+        ));
+        total += most * copies;
+    }
+    if !lines.is_empty() {
+        lines.push(format!(
+            "created during the run: up to {total} particles, {} in all",
+            total + sim.particles.len() as u64
+        ));
+    }
+    lines
 }
