@@ -6,6 +6,7 @@ use crate::create::source::SourceState;
 use crate::files::{Decoder, Encoder, write_atomic};
 use crate::gpu::DeviceState;
 use crate::rng::Rng;
+use crate::scene::Scene;
 use crate::sim::Simulation;
 use crate::springs::SpringTable;
 use crate::state::{GEAR_VALUES, Particles};
@@ -36,6 +37,9 @@ pub enum CheckpointError {
     Corrupt(String, crate::files::DecodeError),
     #[error("checkpoint {0} holds an invalid scene: {1}")]
     Scene(String, crate::scene::SceneError),
+    /// A new stage's scene (`--from`) that cannot continue the state.
+    #[error("--from {0}: {1}")]
+    Stage(String, crate::scene::SceneError),
 }
 
 pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
@@ -163,6 +167,118 @@ impl Checkpoint {
 /// the continuation.
 pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointError> {
     let name = path.display().to_string();
+    for o in overrides {
+        let key = o.split('=').next().unwrap_or("").trim();
+        if !(key.starts_with("stop.") || key.starts_with("output.") || key == "skin") {
+            return Err(CheckpointError::Scene(
+                name,
+                crate::scene::SceneError::invalid(
+                    key,
+                    "only stop.*, output.* and skin can be changed when resuming",
+                ),
+            ));
+        }
+    }
+    decode(path, |text| {
+        crate::scene::parse(text, overrides).map_err(|e| CheckpointError::Scene(name.clone(), e))
+    })
+}
+
+/// The state of a checkpoint under a new scene: the next stage of a multi-stage run
+/// (`talus run SCENE --from CHECKPOINT`), which may change gravity, the contact law and
+/// its parameters, the walls, the domain, the stop rule and the outputs, and goes on
+/// from the checkpoint's step and time. What was created cannot change under it: the
+/// scene's `particles` (its point sources continue where they were), its materials
+/// (the particles' masses were made from their densities), `replicas`, and `dt` (Gear's
+/// state is scaled by it). A GPU run starts on the device from the f64 state.
+pub fn read_as_stage(path: &Path, scene: Scene) -> Result<Checkpoint, CheckpointError> {
+    let name = path.display().to_string();
+    let mut start = decode(path, |text| {
+        let old =
+            crate::scene::parse(text, &[]).map_err(|e| CheckpointError::Scene(name.clone(), e))?;
+        stage_fits(&old, &scene).map_err(|e| CheckpointError::Stage(name.clone(), e))?;
+        Ok(scene)
+    })?;
+    if start.sim.time() >= start.sim.scene.stop.time {
+        return Err(CheckpointError::Stage(
+            name,
+            crate::scene::SceneError::invalid(
+                "stop.time",
+                format!(
+                    "the state is at t = {}, at or past the stage's stop.time {}: a stage \
+                     goes on from the state's time",
+                    start.sim.time(),
+                    start.sim.scene.stop.time
+                ),
+            ),
+        ));
+    }
+    start.device = None;
+    Ok(start)
+}
+
+/// Whether `new` can take over the state that `old` made (`read_as_stage`).
+fn stage_fits(old: &Scene, new: &Scene) -> Result<(), crate::scene::SceneError> {
+    use crate::scene::SceneError;
+    if json(&old.particles) != json(&new.particles) {
+        return Err(SceneError::invalid(
+            "particles",
+            "differs from the scene that made the state: a stage goes on with the particles \
+             (and point sources) it has; change gravity, contact, walls, stop or output",
+        ));
+    }
+    let names = |s: &Scene| s.materials.keys().cloned().collect::<Vec<_>>().join(", ");
+    if names(old) != names(new) {
+        return Err(SceneError::invalid(
+            "materials",
+            format!(
+                "the state's particles are of {}; the scene has {}",
+                names(old),
+                names(new)
+            ),
+        ));
+    }
+    for (k, m) in &old.materials {
+        if json(m) != json(&new.materials[k]) {
+            return Err(SceneError::invalid(
+                format!("materials.{k}"),
+                "differs from the state's (its particles' masses were made from it)",
+            ));
+        }
+    }
+    if old.replicas != new.replicas {
+        return Err(SceneError::invalid(
+            "replicas",
+            format!(
+                "the state has {} copies, the scene {}",
+                old.replicas, new.replicas
+            ),
+        ));
+    }
+    if old.dt != new.dt {
+        return Err(SceneError::invalid(
+            "dt",
+            format!(
+                "the state was integrated at dt = {} (Gear's state is scaled by it), the \
+                 scene has {}",
+                old.dt, new.dt
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// A part of a scene as the scene file says it, for comparing two.
+fn json<T: serde::Serialize>(v: &T) -> serde_json::Value {
+    serde_json::to_value(v).unwrap_or_default()
+}
+
+/// Decodes a checkpoint, its scene made from the scene text it holds by `scene`.
+fn decode(
+    path: &Path,
+    scene: impl FnOnce(&str) -> Result<Scene, CheckpointError>,
+) -> Result<Checkpoint, CheckpointError> {
+    let name = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| CheckpointError::Io(name.clone(), e))?;
     if bytes.len() >= 8 && &bytes[..8] == OLD_MAGIC {
         return Err(CheckpointError::OldFormat(name));
@@ -185,20 +301,7 @@ pub fn read(path: &Path, overrides: &[String]) -> Result<Checkpoint, CheckpointE
     let corrupt = |e| CheckpointError::Corrupt(name.clone(), e);
     let mut d = Decoder::new(&body[8..]);
     let scene_text = d.str().map_err(corrupt)?;
-    for o in overrides {
-        let key = o.split('=').next().unwrap_or("").trim();
-        if !(key.starts_with("stop.") || key.starts_with("output.") || key == "skin") {
-            return Err(CheckpointError::Scene(
-                name,
-                crate::scene::SceneError::invalid(
-                    key,
-                    "only stop.*, output.* and skin can be changed when resuming",
-                ),
-            ));
-        }
-    }
-    let scene = crate::scene::parse(&scene_text, overrides)
-        .map_err(|e| CheckpointError::Scene(name.clone(), e))?;
+    let scene = scene(&scene_text)?;
     let step = d.u64().map_err(corrupt)?;
     let lost = d.u64().map_err(corrupt)?;
     let rng = Rng {

@@ -20,6 +20,8 @@ mod check;
 mod failure;
 #[path = "cli/reproduce.rs"]
 mod reproduce;
+#[path = "cli/run.rs"]
+mod run_cmd;
 #[path = "cli/sweep.rs"]
 mod sweep;
 
@@ -27,11 +29,11 @@ use failure::Failure;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::AtomicBool;
 use talus::gpu::GpuSimulation;
 use talus::gpu::device::{self, BackendChoice as Backend};
 use talus::run::Engine;
-use talus::{bench, checkpoint, run, scene, sim::Simulation};
+use talus::{bench, checkpoint, scene, sim::Simulation};
 
 #[derive(Parser)]
 #[command(
@@ -60,10 +62,17 @@ enum Command {
         /// Override a scene key, e.g. --set contact.mu=0.3 (repeatable).
         #[arg(long = "set", value_name = "PATH=VALUE")]
         overrides: Vec<String>,
-        /// Continue from a checkpoint file (only stop.*, output.* and skin may be --set).
-        /// One of the output folder's own continues that run there.
+        /// Continue from a checkpoint file (only stop.*, output.* and skin may be --set),
+        /// in the checkpoint's own run folder unless --out says otherwise.
         #[arg(long, conflicts_with = "scene")]
         resume: Option<PathBuf>,
+        /// Start from the state of an earlier run (its folder, for its newest
+        /// checkpoint, or a checkpoint) under this scene: the next stage of a
+        /// multi-stage run. The scene may change gravity, the contact law, walls, the
+        /// domain, stop and output; its particles, materials and dt must be the
+        /// earlier run's. Time goes on from the state's.
+        #[arg(long, conflicts_with = "resume", value_name = "RUN_DIR|CHECKPOINT")]
+        from: Option<PathBuf>,
         /// Clear another run's outputs from the output folder first (otherwise such a
         /// folder is refused).
         #[arg(long)]
@@ -292,10 +301,11 @@ fn command(command: Command, threads: usize) -> ExitCode {
             out,
             overrides,
             resume,
+            from,
             force,
             backend,
             quiet,
-        } => cmd_run(scene, out, overrides, resume, force, backend, quiet),
+        } => run_cmd::cmd_run(scene, out, overrides, resume, from, force, backend, quiet),
         Command::Check {
             scene,
             overrides,
@@ -447,102 +457,6 @@ fn degrees(a: f64) -> String {
     } else {
         "none".to_string()
     }
-}
-
-fn cmd_run(
-    path: Option<PathBuf>,
-    out: Option<PathBuf>,
-    overrides: Vec<String>,
-    resume: Option<PathBuf>,
-    force: bool,
-    backend: Backend,
-    quiet: bool,
-) -> Result<(), Failure> {
-    let start = match &resume {
-        Some(ckpt) => checkpoint::read(ckpt, &overrides)?,
-        None => checkpoint::Checkpoint::fresh(build_simulation(&path, &overrides)?),
-    };
-    let sim = &start.sim;
-    let out = out.unwrap_or_else(|| PathBuf::from("runs").join(&sim.scene.name));
-    if !quiet {
-        eprintln!(
-            "talus: scene `{}`, {} particles, dt = {}, until t = {} -> {}",
-            sim.scene.name,
-            sim.particles.active_count(),
-            sim.dt(),
-            sim.scene.stop.time,
-            out.display()
-        );
-    }
-    // Before the engine is made (a GPU takes a while): `run::run` would refuse it too.
-    run::folder::refuse_another_run(&out, resume.as_deref(), force)?;
-    let mut engine = choose_engine(start, backend, quiet)?;
-    if !quiet {
-        eprintln!("backend: {}", engine.name());
-    }
-    let interrupt = on_interrupt();
-    let s = run::run(
-        &mut engine,
-        &run::RunOptions {
-            out: out.clone(),
-            quiet,
-            force,
-            resumed_from: resume,
-            interrupt: interrupt.clone(),
-            ..Default::default()
-        },
-    )?;
-    if !quiet {
-        eprintln!(
-            "done: {} steps to t = {:.4} ({}), {} particles ({} moving, {} lost), {:.3e} particle-steps/s of the moving ones; results in {}",
-            s.steps,
-            s.time,
-            if s.settled { "settled" } else { "end time" },
-            s.particles,
-            s.mobile,
-            s.lost,
-            s.particle_steps_per_second,
-            out.display()
-        );
-    }
-    if interrupt.load(Ordering::Relaxed) {
-        return Err(Failure::interrupted(format!(
-            "interrupted after the run finished: its final state was not analysed \
-             (`talus analyze {}` does it)",
-            out.display()
-        )));
-    }
-    // The final state's measurements and pictures; a failure here does not undo the run.
-    // With copies of the scene, each copy's (their heaps lie on top of each other in the
-    // whole state).
-    let folders: Vec<PathBuf> = match engine.host().scene.replicas {
-        1 => vec![out.clone()],
-        k => (0..k).map(|c| run::copy_dir(&out, c)).collect(),
-    };
-    for dir in &folders {
-        match measure_and_draw(
-            dir,
-            &dir.join("analysis"),
-            &dir.join("pictures"),
-            &talus::analyze::Options::default(),
-            None,
-            talus::render::Field::Pressure,
-            1600,
-        ) {
-            Ok(n) if !quiet => eprintln!(
-                "measurements in {}/analysis, pictures in {}/pictures ({n} files)",
-                dir.display(),
-                dir.display()
-            ),
-            Ok(_) => {}
-            Err(e) => eprintln!(
-                "warning: the final state of {} could not be analysed: {}",
-                dir.display(),
-                e.message
-            ),
-        }
-    }
-    Ok(())
 }
 
 /// A flag that SIGINT and SIGTERM set: the run stops between two advances, removes its

@@ -2,7 +2,7 @@
 //! panic; a diverging run stops with the step, the particle ids and the checkpoint.
 
 use serde_json::json;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn talus(args: &[&str]) -> (i32, String, String) {
@@ -1205,4 +1205,108 @@ fn check_says_whether_a_scene_fits_the_gpu() {
         "{err}"
     );
     assert!(!err.contains("panicked"), "{err}");
+}
+
+#[test]
+fn a_stage_goes_on_from_an_earlier_run_under_a_new_scene() {
+    // Issue 41 item 4: pour for 20 time units, then tilt gravity by 5° and go on. The
+    // stage starts from the earlier run's newest checkpoint (its end), at its time.
+    let dir = tmp("stages");
+    let (first, tilted, same, resumed) = (
+        dir.join("pour"),
+        dir.join("tilted"),
+        dir.join("same"),
+        dir.join("resumed"),
+    );
+    let s = |p: &PathBuf| p.to_str().unwrap().to_string();
+    let (code, _, err) = talus(&["run", "-q", "--set", "stop.time=20", "--out", &s(&first)]);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--from",
+        &s(&first),
+        "--set",
+        "stop.time=24",
+        "--set",
+        "gravity.g=[0.08716,-0.99619]",
+        "--out",
+        &s(&tilted),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let read = |p: PathBuf| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    let summary = read(tilted.join("summary.json"));
+    assert_eq!(summary["time"], 24.0);
+    assert_eq!(summary["steps"], 2000, "from t = 20 to 24 at dt = 0.002");
+    assert_eq!(
+        read(tilted.join("scene.json"))["gravity"]["g"],
+        json!([0.08716, -0.99619])
+    );
+    // The pour goes on where it was: more grains than at t = 20.
+    let before = read(first.join("summary.json"))["particles"]
+        .as_u64()
+        .unwrap();
+    assert!(summary["particles"].as_u64().unwrap() > before);
+    // A stage that changes nothing is the resumed run, bit for bit.
+    let ckpt = first.join("checkpoints/ckpt_0000010000.bin");
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--from",
+        &s(&ckpt),
+        "--set",
+        "stop.time=24",
+        "--out",
+        &s(&same),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    let (code, _, err) = talus(&[
+        "run",
+        "-q",
+        "--resume",
+        &s(&ckpt),
+        "--set",
+        "stop.time=24",
+        "--out",
+        &s(&resumed),
+    ]);
+    assert_eq!(code, 0, "{err}");
+    assert_eq!(
+        std::fs::read(same.join("final.bin")).unwrap(),
+        std::fs::read(resumed.join("final.bin")).unwrap()
+    );
+    // What a stage cannot change, named; a snapshot is no start.
+    let refused = |extra: &[&str], from: &Path, must: &[&str]| {
+        let mut args = vec!["run", "-q", "--from", from.to_str().unwrap()];
+        args.extend(extra);
+        let out = dir.join("refused");
+        args.extend(["--out", out.to_str().unwrap()]);
+        let (code, _, err) = talus(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        for m in must {
+            assert!(err.contains(m), "{args:?}: {err}");
+        }
+        assert!(!out.join("summary.json").exists());
+    };
+    let st = ["--set", "stop.time=30"];
+    refused(
+        &[st[0], st[1], "--set", "particles[1].count=10"],
+        &first,
+        &["particles", "differs"],
+    );
+    refused(
+        &[st[0], st[1], "--set", "dt=0.001"],
+        &first,
+        &["dt", "0.002"],
+    );
+    refused(
+        &[st[0], st[1], "--set", "materials.grain.density=2"],
+        &first,
+        &["materials.grain"],
+    );
+    refused(&["--set", "stop.time=10"], &first, &["stop.time", "t = 20"]);
+    refused(&st, &first.join("final.json"), &["snapshot", "checkpoints"]);
+    refused(&st, &dir.join("nowhere"), &["nowhere"]);
 }
