@@ -346,22 +346,6 @@ fn damaged_snapshots_are_refused_by_analyze_and_render() {
     }
 }
 
-/// The numbers of the VTK DataArray called `name` (ASCII format).
-fn data_array(xml: &str, name: &str) -> Vec<f64> {
-    let tag = format!("Name=\"{name}\"");
-    let at = xml
-        .find(&tag)
-        .unwrap_or_else(|| panic!("no DataArray {name}"));
-    let body = &xml[at..];
-    let body = &body[body.find('>').unwrap() + 1..body.find("</DataArray>").unwrap()];
-    body.split_whitespace()
-        .map(|v| {
-            v.parse()
-                .unwrap_or_else(|_| panic!("{name}: {v} is no number"))
-        })
-        .collect()
-}
-
 #[test]
 fn render_draws_pictures_and_vtk_files_of_the_column() {
     let s = settled_column();
@@ -440,42 +424,51 @@ fn render_draws_pictures_and_vtk_files_of_the_column() {
         (painted / grains_px - 1.0).abs() < 0.05,
         "{painted} pixels painted against {grains_px} for the grains"
     );
-    // VTK: read back, N grains as polygons around the grains' centres and N contacts
+    // VTK, read back: N disks as points at the grains' centres with their radii, the
+    // net contact force on each balancing its weight (settled, g = 1), and N contacts
     // as lines.
-    let vtp = std::fs::read_to_string(out.join("grains.vtp")).unwrap();
-    assert!(
-        vtp.contains(&format!("NumberOfPolys=\"{N}\"")),
-        "grains.vtp"
+    let vtp = common::vtp::read(&out.join("grains.vtp"));
+    assert_eq!(
+        (vtp.count("NumberOfVerts"), vtp.count("NumberOfPolys")),
+        (N, 0)
     );
-    let points = data_array(&vtp, "Points");
-    let offsets = data_array(&vtp, "offsets");
-    let connectivity = data_array(&vtp, "connectivity");
-    assert_eq!(offsets.len(), N, "one polygon per grain");
-    assert_eq!(*offsets.last().unwrap() as usize, connectivity.len());
-    let mut start = 0;
-    for (k, end) in offsets.iter().enumerate() {
-        let cell = &connectivity[start..*end as usize];
-        let (mut x, mut z) = (0.0, 0.0);
-        for &p in cell {
-            x += points[3 * p as usize] / cell.len() as f64;
-            z += points[3 * p as usize + 1] / cell.len() as f64;
-        }
-        let g = &a.input.grains[k];
-        assert!(
-            (x - g.x).abs() < 1e-9 && (z - g.z).abs() < 1e-9,
-            "polygon {k} around ({x}, {z}), grain at ({}, {})",
-            g.x,
-            g.z
+    let points = vtp.get("Points", "Points");
+    let (radius, force) = (vtp.get("PointData", "radius"), vtp.get("CellData", "force"));
+    let (ids, velocity) = (vtp.get("CellData", "id"), vtp.get("CellData", "velocity"));
+    // Float32 in the file.
+    let f32 = |x: f64| x as f32 as f64;
+    for (k, g) in a.input.grains.iter().enumerate() {
+        assert_eq!(
+            [points[3 * k], points[3 * k + 1]],
+            [f32(g.x), f32(g.z)],
+            "grain {k}"
         );
-        start = *end as usize;
+        assert_eq!(radius[k], f32(g.radius));
+        assert_eq!(ids[k], g.id as f64);
+        assert_eq!(
+            [velocity[3 * k], velocity[3 * k + 1]],
+            [f32(g.velocity[0]), f32(g.velocity[1])]
+        );
+        assert!(
+            force[3 * k].abs() < 1e-6 && (force[3 * k + 1] - g.mass).abs() < 1e-3 * g.mass,
+            "grain {k}: net contact force ({}, {}) against its weight {}",
+            force[3 * k],
+            force[3 * k + 1],
+            g.mass
+        );
     }
-    assert_eq!(data_array(&vtp, "id").len(), N, "one id per grain");
-    let vtp = std::fs::read_to_string(out.join("contacts.vtp")).unwrap();
-    assert!(
-        vtp.contains(&format!("NumberOfLines=\"{N}\"")),
-        "contacts.vtp"
+    let torque = vtp.get("CellData", "torque");
+    assert!(torque.iter().all(|t| t.abs() < 1e-9), "{torque:?}");
+    let vtp = common::vtp::read(&out.join("contacts.vtp"));
+    assert_eq!(vtp.count("NumberOfLines"), N, "one line per contact");
+    assert_eq!(vtp.get("Lines", "offsets").len(), N);
+    let (f, m) = (
+        vtp.get("CellData", "force"),
+        vtp.get("CellData", "force_magnitude"),
     );
-    assert_eq!(data_array(&vtp, "offsets").len(), N, "one line per contact");
+    for k in 0..N {
+        assert!((f[3 * k].hypot(f[3 * k + 1]) - m[k]).abs() <= 1e-6 * m[k]);
+    }
     for f in ["base_profile.svg", "force_distribution.svg"] {
         assert!(out.join(f).is_file(), "{f}");
     }
@@ -571,8 +564,8 @@ fn a_run_with_output_vtk_writes_a_paraview_time_series() {
         .collect();
     assert!(files.len() >= 6 && files.len().is_multiple_of(2), "{pvd}");
     for f in &files {
-        let text = std::fs::read_to_string(dir.join("snapshots").join(f)).unwrap();
-        assert!(text.contains("<PolyData>"), "{f}");
+        let vtp = common::vtp::read(&dir.join("snapshots").join(f));
+        assert!(vtp.header.contains("<PolyData>"), "{f}");
     }
     // The run writes them from the state in memory (issue 16 item 7): byte for byte what
     // `talus render` writes from the snapshot files.
@@ -941,6 +934,7 @@ fn an_m_shaped_base_load_has_its_side_maxima_above_the_centre() {
         fixed,
         area: std::f64::consts::FRAC_PI_4,
         corners: Vec::new(),
+        ..Default::default()
     };
     let mut grains = Vec::new();
     let mut touches = Vec::new();
@@ -1004,6 +998,7 @@ fn base_input(name: &str, loads: &[f64]) -> analyze::input::Input {
         fixed,
         area: std::f64::consts::FRAC_PI_4,
         corners: Vec::new(),
+        ..Default::default()
     };
     let mut grains = Vec::new();
     let mut touches = Vec::new();
@@ -1126,4 +1121,82 @@ fn the_base_load_summary_tells_an_m_from_force_chain_noise() {
     assert!(se > 0.0 && se < 1.5, "{csv}");
     let stress = std::fs::read_to_string(one.join("stress.csv")).unwrap();
     assert!(stress.lines().next().unwrap().ends_with("se S_xx,se S_zz"));
+}
+
+#[test]
+fn vtk_draws_disks_as_points_and_polygons_as_their_outlines() {
+    // Issue 41 item 2: eight disks in a row on a floor and a pentagon resting on them.
+    // VTK orders vertices before polygons: the disks first (points at their centres
+    // with their radii), then the pentagon (its five world corners, radius 0 at each).
+    let row: Vec<_> = (0..8)
+        .map(|k| json!({ "position": [k as f64 * 0.99, 0.499], "diameter": 1.0 }))
+        .collect();
+    let mut v = common::scene_value(
+        json!({ "law": "overlap_area", "k_n": 1e4, "mu": 0.5 }),
+        json!([{ "kind": "list", "material": "m", "polygon": { "corners": 5 },
+                 "particles": [{ "position": [2.0, 1.45], "diameter": 1.0 }] },
+               { "kind": "list", "material": "m", "particles": row }]),
+    );
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-5.0, 0.0], "to": [15.0, 0.0] }]);
+    let mut s = common::sim(&v);
+    s.advance(400).unwrap();
+    let dir = tmp("vtk-mixed");
+    let json_path = talus::snapshot::write(&s, &dir, "snap").unwrap();
+    let out = dir.join("pictures");
+    let o = std::process::Command::new(common::talus_bin())
+        .args(["render", "--width", "64", "--out"])
+        .arg(&out)
+        .arg(&json_path)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let snap = talus::snapshot::read(&json_path).unwrap();
+    let vtp = common::vtp::read(&out.join("grains.vtp"));
+    assert_eq!(
+        (vtp.count("NumberOfVerts"), vtp.count("NumberOfPolys")),
+        (8, 1)
+    );
+    assert_eq!(vtp.count("NumberOfPoints"), 8 + 5);
+    // The pentagon was created first (id 0): it comes last, after the disks 1–8.
+    let ids = vtp.get("CellData", "id");
+    assert_eq!(ids, [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 0.0]);
+    let points = vtp.get("Points", "Points");
+    let radius = vtp.get("PointData", "radius");
+    let f32 = |x: f64| x as f32 as f64;
+    let (x, z) = (
+        snap.f64("particles.x").unwrap(),
+        snap.f64("particles.z").unwrap(),
+    );
+    for k in 0..8 {
+        assert_eq!(
+            [points[3 * k], points[3 * k + 1]],
+            [f32(x[k + 1]), f32(z[k + 1])]
+        );
+        assert_eq!(radius[k], 0.5);
+    }
+    assert_eq!(
+        vtp.get("Verts", "connectivity"),
+        [0., 1., 2., 3., 4., 5., 6., 7.]
+    );
+    assert_eq!(vtp.get("Polys", "connectivity"), [8., 9., 10., 11., 12.]);
+    assert_eq!(vtp.get("Polys", "offsets"), [5.0]);
+    let theta = snap.f64("particles.theta").unwrap()[0];
+    let (cx, cz) = (
+        snap.f64("corners.x").unwrap(),
+        snap.f64("corners.z").unwrap(),
+    );
+    for c in 0..5 {
+        let (sn, cs) = theta.sin_cos();
+        let want = [
+            x[0] + cs * cx[c] - sn * cz[c],
+            z[0] + sn * cx[c] + cs * cz[c],
+        ];
+        let p = 3 * (8 + c);
+        assert!(
+            (points[p] - want[0]).abs() < 1e-6 && (points[p + 1] - want[1]).abs() < 1e-6,
+            "corner {c}"
+        );
+        assert_eq!(radius[8 + c], 0.0);
+    }
 }

@@ -39,6 +39,7 @@ fn column(units: &str) -> Analysis {
             fixed: false,
             area: PI / 4.0,
             corners: Vec::new(),
+            ..Default::default()
         })
         .collect();
     let touches = (0..N)

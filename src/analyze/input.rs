@@ -9,7 +9,7 @@ use crate::snapshot::{self, Snapshot};
 use std::path::{Path, PathBuf};
 
 /// One particle of the snapshot.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Grain {
     pub id: u32,
     pub x: f64,
@@ -19,6 +19,9 @@ pub struct Grain {
     pub radius: f64,
     pub mass: f64,
     pub fixed: bool,
+    /// Velocity (x, z) and angular velocity.
+    pub velocity: P2,
+    pub omega: f64,
     /// Area of the actual shape (per unit thickness).
     pub area: f64,
     /// World corners (empty for a disk; a rod's outline, its core swept by its sweep
@@ -185,6 +188,11 @@ pub fn of_snapshot(
     let f = |name| column(s, name, Snapshot::f64);
     let (xs, zs, th) = (f("particles.x")?, f("particles.z")?, f("particles.theta")?);
     let (rs, ms) = (f("particles.radius")?, f("particles.mass")?);
+    let (vx, vz, om) = (
+        f("particles.vx")?,
+        f("particles.vz")?,
+        f("particles.omega")?,
+    );
     let ids = column(s, "particles.id", Snapshot::u32)?;
     let counts = column(s, "particles.corners", Snapshot::u32)?;
     let (cx, cz) = (
@@ -233,6 +241,8 @@ pub fn of_snapshot(
             radius: rs[k],
             mass: ms[k],
             fixed: fixed[k],
+            velocity: [vx[k], vz[k]],
+            omega: om[k],
             area: a,
             corners,
         });

@@ -361,6 +361,7 @@ mod tests {
                 fixed: false,
                 area: 0.03,
                 corners: Vec::new(),
+                ..Default::default()
             })
             .collect();
         let moments: Vec<Tensor> = (0..400)

@@ -1,5 +1,11 @@
-//! VTK PolyData (`.vtp`, XML, ASCII) for ParaView: the grains as polygons (disks as
-//! 32-gons) with per-grain fields, and the contact network as lines with forces.
+//! VTK PolyData (`.vtp`) for ParaView and OVITO, in the XML format with its data
+//! appended raw and zlib-compressed (binary, little-endian, UInt64 headers; the VTK
+//! file-format documentation's "appended" encoding with `vtkZLibDataCompressor`): the
+//! grains, disks as points (a vertex each, with a `radius` point array for glyphs) and
+//! polygons and rods as outlines, with per-grain vectors (velocity, net contact force)
+//! and scalars; the contact network as lines with their forces. The files are for
+//! viewing: values are Float32 (the snapshots hold them exactly). `collection` writes
+//! the `.pvd` time series of a run.
 
 use super::RenderError;
 use crate::analyze::Analysis;
@@ -7,81 +13,174 @@ use crate::files::write_atomic;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-fn array(
-    out: &mut String,
-    name: &str,
-    kind: &str,
+/// One data array: its name, VTK type, components and little-endian values.
+struct Array {
+    name: &'static str,
+    kind: &'static str,
     comps: usize,
-    values: impl Iterator<Item = String>,
-) {
-    let _ = writeln!(
-        out,
-        r#"        <DataArray type="{kind}" Name="{name}" NumberOfComponents="{comps}" format="ascii">"#
-    );
-    let v: Vec<String> = values.collect();
-    for chunk in v.chunks(12) {
-        let _ = writeln!(out, "          {}", chunk.join(" "));
-    }
-    out.push_str("        </DataArray>\n");
+    bytes: Vec<u8>,
 }
 
-/// A PolyData piece: points (x, z → x, y, 0), cells as polygons or lines, cell data.
+fn f64s(name: &'static str, comps: usize, values: impl IntoIterator<Item = f64>) -> Array {
+    let bytes = (values.into_iter())
+        .flat_map(|v| (v as f32).to_le_bytes())
+        .collect();
+    Array {
+        name,
+        kind: "Float32",
+        comps,
+        bytes,
+    }
+}
+
+fn u32s(name: &'static str, values: impl IntoIterator<Item = u32>) -> Array {
+    let bytes = values.into_iter().flat_map(u32::to_le_bytes).collect();
+    Array {
+        name,
+        kind: "UInt32",
+        comps: 1,
+        bytes,
+    }
+}
+
+fn u8s(name: &'static str, values: impl IntoIterator<Item = u8>) -> Array {
+    Array {
+        name,
+        kind: "UInt8",
+        comps: 1,
+        bytes: values.into_iter().collect(),
+    }
+}
+
+fn i32s(name: &'static str, values: impl IntoIterator<Item = usize>) -> Array {
+    let bytes = (values.into_iter())
+        .flat_map(|v| (v as i32).to_le_bytes())
+        .collect();
+    Array {
+        name,
+        kind: "Int32",
+        comps: 1,
+        bytes,
+    }
+}
+
+/// Uncompressed bytes per compressed block (VTK's default).
+const BLOCK: usize = 1 << 15;
+
+/// An array's appended block as `vtkZLibDataCompressor` writes it: the number of
+/// blocks, the block size, the last block's size and each block's compressed size (all
+/// UInt64), then the compressed blocks.
+fn compressed(bytes: &[u8]) -> Vec<u8> {
+    use std::io::Write as _;
+    let blocks: Vec<Vec<u8>> = (bytes.chunks(BLOCK))
+        .map(|chunk| {
+            let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+            z.write_all(chunk).expect("writes to memory");
+            z.finish().expect("writes to memory")
+        })
+        .collect();
+    let last = match bytes.len() % BLOCK {
+        0 if !bytes.is_empty() => BLOCK,
+        r => r,
+    };
+    let mut out = Vec::new();
+    for v in [blocks.len(), BLOCK, last]
+        .into_iter()
+        .chain(blocks.iter().map(Vec::len))
+    {
+        out.extend_from_slice(&(v as u64).to_le_bytes());
+    }
+    blocks.iter().for_each(|b| out.extend_from_slice(b));
+    out
+}
+
+/// 2D vectors (x, z) as VTK's 3-component vectors in the x–y plane.
+fn vectors(name: &'static str, values: impl IntoIterator<Item = [f64; 2]>) -> Array {
+    f64s(name, 3, values.into_iter().flat_map(|v| [v[0], v[1], 0.0]))
+}
+
+/// A PolyData piece: points (x, z → x, y, 0) and its cells by kind, in VTK's cell
+/// order (vertices, lines, polygons), with point and cell data in that order.
+#[derive(Default)]
 struct Piece {
     points: Vec<[f64; 2]>,
-    cells: Vec<Vec<usize>>,
-    lines: bool,
-    data: Vec<(String, &'static str, Vec<String>)>,
+    verts: Vec<Vec<usize>>,
+    lines: Vec<Vec<usize>>,
+    polys: Vec<Vec<usize>>,
+    point_data: Vec<Array>,
+    cell_data: Vec<Array>,
 }
 
-fn write_piece(path: &Path, p: &Piece) -> Result<(), RenderError> {
-    let mut s = String::new();
-    s.push_str("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n");
-    let (nl, np) = if p.lines {
-        (p.cells.len(), 0)
-    } else {
-        (0, p.cells.len())
-    };
+fn write_piece(path: &Path, p: Piece) -> Result<(), RenderError> {
+    let mut xml = String::from(
+        "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\" \
+         byte_order=\"LittleEndian\" header_type=\"UInt64\" \
+         compressor=\"vtkZLibDataCompressor\">\n  <PolyData>\n",
+    );
     let _ = writeln!(
-        s,
-        r#"    <Piece NumberOfPoints="{}" NumberOfVerts="0" NumberOfLines="{nl}" NumberOfStrips="0" NumberOfPolys="{np}">"#,
-        p.points.len()
+        xml,
+        r#"    <Piece NumberOfPoints="{}" NumberOfVerts="{}" NumberOfLines="{}" NumberOfStrips="0" NumberOfPolys="{}">"#,
+        p.points.len(),
+        p.verts.len(),
+        p.lines.len(),
+        p.polys.len()
     );
-    s.push_str("      <Points>\n");
-    array(
-        &mut s,
+    let mut blocks: Vec<u8> = Vec::new();
+    let mut section = |xml: &mut String, tag: &str, arrays: Vec<Array>| {
+        let _ = writeln!(xml, "      <{tag}>");
+        for a in arrays {
+            let _ = writeln!(
+                xml,
+                r#"        <DataArray type="{}" Name="{}" NumberOfComponents="{}" format="appended" offset="{}"/>"#,
+                a.kind,
+                a.name,
+                a.comps,
+                blocks.len()
+            );
+            blocks.extend_from_slice(&compressed(&a.bytes));
+        }
+        let _ = writeln!(xml, "      </{tag}>");
+    };
+    section(&mut xml, "PointData", p.point_data);
+    section(&mut xml, "CellData", p.cell_data);
+    section(
+        &mut xml,
         "Points",
-        "Float64",
-        3,
-        p.points.iter().map(|q| format!("{:e} {:e} 0", q[0], q[1])),
+        vec![f64s(
+            "Points",
+            3,
+            p.points.iter().flat_map(|q| [q[0], q[1], 0.0]),
+        )],
     );
-    s.push_str("      </Points>\n      <CellData>\n");
-    for (name, kind, values) in &p.data {
-        array(&mut s, name, kind, 1, values.iter().cloned());
+    for (tag, cells) in [
+        ("Verts", &p.verts),
+        ("Lines", &p.lines),
+        ("Polys", &p.polys),
+    ] {
+        if cells.is_empty() {
+            continue;
+        }
+        let mut end = 0;
+        let offsets: Vec<usize> = (cells.iter())
+            .map(|c| {
+                end += c.len();
+                end
+            })
+            .collect();
+        section(
+            &mut xml,
+            tag,
+            vec![
+                i32s("connectivity", cells.iter().flatten().copied()),
+                i32s("offsets", offsets),
+            ],
+        );
     }
-    s.push_str("      </CellData>\n");
-    let tag = if p.lines { "Lines" } else { "Polys" };
-    let _ = writeln!(s, "      <{tag}>");
-    array(
-        &mut s,
-        "connectivity",
-        "Int64",
-        1,
-        p.cells.iter().flatten().map(|k| k.to_string()),
-    );
-    let mut end = 0;
-    array(
-        &mut s,
-        "offsets",
-        "Int64",
-        1,
-        p.cells.iter().map(|c| {
-            end += c.len();
-            end.to_string()
-        }),
-    );
-    let _ = writeln!(s, "      </{tag}>");
-    s.push_str("    </Piece>\n  </PolyData>\n</VTKFile>\n");
-    write_atomic(path, s.as_bytes()).map_err(RenderError::write(path))
+    xml.push_str("    </Piece>\n  </PolyData>\n  <AppendedData encoding=\"raw\">\n   _");
+    let mut bytes = xml.into_bytes();
+    bytes.extend_from_slice(&blocks);
+    bytes.extend_from_slice(b"\n  </AppendedData>\n</VTKFile>\n");
+    write_atomic(path, &bytes).map_err(RenderError::write(path))
 }
 
 /// Writes `grains.vtp` and `contacts.vtp` into `dir`.
@@ -102,128 +201,109 @@ pub fn collection(entries: &[(f64, String, String)]) -> String {
     s
 }
 
+/// Each grain's net contact force and torque about its centre (2D: out of the plane,
+/// counter-clockwise in the x–z plane positive), from the snapshot's contacts.
+fn net_loads(a: &Analysis) -> Vec<([f64; 2], f64)> {
+    let grains = &a.input.grains;
+    let mut loads = vec![([0.0; 2], 0.0); grains.len()];
+    let mut add = |k: usize, f: [f64; 2], point: [f64; 2]| {
+        let (dx, dz) = (point[0] - grains[k].x, point[1] - grains[k].z);
+        let (force, torque) = &mut loads[k];
+        force[0] += f[0];
+        force[1] += f[1];
+        *torque += dx * f[1] - dz * f[0];
+    };
+    for t in &a.input.touches {
+        add(t.a, t.force, t.point);
+        if let Some(b) = t.b {
+            add(b, [-t.force[0], -t.force[1]], t.point);
+        }
+    }
+    loads
+}
+
 /// Writes `{prefix}grains.vtp` and `{prefix}contacts.vtp` into `dir`.
 pub fn write_named(a: &Analysis, dir: &Path, prefix: &str) -> Result<Vec<PathBuf>, RenderError> {
     let grains = &a.input.grains;
-    let mut points = Vec::new();
-    let mut cells = Vec::new();
-    for g in grains {
-        let outline: Vec<[f64; 2]> = if g.corners.len() >= 3 {
-            g.corners.clone()
-        } else {
-            (0..32)
-                .map(|k| {
-                    let t = std::f64::consts::TAU * k as f64 / 32.0;
-                    [g.x + g.radius * t.cos(), g.z + g.radius * t.sin()]
-                })
-                .collect()
-        };
-        cells.push((points.len()..points.len() + outline.len()).collect());
-        points.extend(outline);
-    }
-    let e = |x: f64| format!("{x:e}");
-    let pressure: Vec<String> = grains
-        .iter()
-        .enumerate()
-        .map(|(k, g)| {
-            let (s1, s2, _) = a.moments[k].scaled(1.0 / g.area).principal();
-            e(0.5 * (s1 + s2))
-        })
+    // VTK orders cells vertices first, then polygons: the disks, then the rest.
+    let is_disk = |k: &usize| grains[*k].corners.len() < 3;
+    let order: Vec<usize> = (0..grains.len())
+        .filter(is_disk)
+        .chain((0..grains.len()).filter(|k| !is_disk(k)))
         .collect();
-    let piece = Piece {
-        points,
-        cells,
-        lines: false,
-        data: vec![
-            (
-                "id".into(),
-                "UInt32",
-                grains.iter().map(|g| g.id.to_string()).collect(),
-            ),
-            (
-                "radius".into(),
-                "Float64",
-                grains.iter().map(|g| e(g.radius)).collect(),
-            ),
-            (
-                "mass".into(),
-                "Float64",
-                grains.iter().map(|g| e(g.mass)).collect(),
-            ),
-            (
-                "theta".into(),
-                "Float64",
-                grains.iter().map(|g| e(g.theta)).collect(),
-            ),
-            (
-                "fixed".into(),
-                "UInt8",
-                grains.iter().map(|g| (g.fixed as u8).to_string()).collect(),
-            ),
-            (
-                "contacts".into(),
-                "UInt32",
-                a.counts.iter().map(|c| c.to_string()).collect(),
-            ),
-            (
-                "rattler".into(),
-                "UInt8",
-                a.rattler.iter().map(|&r| (r as u8).to_string()).collect(),
-            ),
-            ("pressure".into(), "Float64", pressure),
-            (
-                "sigma_zz".into(),
-                "Float64",
-                grains
-                    .iter()
-                    .enumerate()
-                    .map(|(k, g)| e(a.moments[k].zz / g.area))
-                    .collect(),
-            ),
-            (
-                "sigma_xx".into(),
-                "Float64",
-                grains
-                    .iter()
-                    .enumerate()
-                    .map(|(k, g)| e(a.moments[k].xx / g.area))
-                    .collect(),
-            ),
-        ],
-    };
+    let mut piece = Piece::default();
+    let mut point_radius = Vec::new();
+    for &k in &order {
+        let g = &grains[k];
+        let first = piece.points.len();
+        if is_disk(&k) {
+            piece.points.push([g.x, g.z]);
+            point_radius.push(g.radius);
+            piece.verts.push(vec![first]);
+        } else {
+            piece.points.extend(&g.corners);
+            point_radius.extend(std::iter::repeat_n(0.0, g.corners.len()));
+            piece.polys.push((first..first + g.corners.len()).collect());
+        }
+    }
+    let loads = net_loads(a);
+    let stress = |k: usize| a.moments[k].scaled(1.0 / grains[k].area);
+    let each = |f: &dyn Fn(usize) -> f64| order.iter().map(|&k| f(k)).collect::<Vec<_>>();
+    piece.point_data = vec![f64s("radius", 1, point_radius)];
+    piece.cell_data = vec![
+        u32s("id", order.iter().map(|&k| grains[k].id)),
+        f64s("radius", 1, each(&|k| grains[k].radius)),
+        f64s("mass", 1, each(&|k| grains[k].mass)),
+        f64s("theta", 1, each(&|k| grains[k].theta)),
+        u8s("fixed", order.iter().map(|&k| grains[k].fixed as u8)),
+        vectors("velocity", order.iter().map(|&k| grains[k].velocity)),
+        f64s("omega", 1, each(&|k| grains[k].omega)),
+        vectors("force", order.iter().map(|&k| loads[k].0)),
+        f64s("torque", 1, each(&|k| loads[k].1)),
+        u32s("contacts", order.iter().map(|&k| a.counts[k] as u32)),
+        u8s("rattler", order.iter().map(|&k| a.rattler[k] as u8)),
+        f64s(
+            "pressure",
+            1,
+            each(&|k| {
+                let (s1, s2, _) = stress(k).principal();
+                0.5 * (s1 + s2)
+            }),
+        ),
+        f64s("sigma_zz", 1, each(&|k| stress(k).zz)),
+        f64s("sigma_xx", 1, each(&|k| stress(k).xx)),
+    ];
     let mut files = Vec::new();
     let p = dir.join(format!("{prefix}grains.vtp"));
-    write_piece(&p, &piece)?;
+    write_piece(&p, piece)?;
     files.push(p);
     // Contacts: lines from centre to centre, or to the contact point on a wall.
-    let mut points = Vec::new();
-    let mut cells = Vec::new();
-    let (mut fnv, mut fmag, mut wall) = (Vec::new(), Vec::new(), Vec::new());
+    let mut piece = Piece::default();
     for t in &a.input.touches {
         let ga = &grains[t.a];
         let end = match t.b {
             Some(b) => [grains[b].x, grains[b].z],
             None => t.point,
         };
-        cells.push(vec![points.len(), points.len() + 1]);
-        points.push([ga.x, ga.z]);
-        points.push(end);
-        fnv.push(e(t.normal_force));
-        fmag.push(e(t.force[0].hypot(t.force[1])));
-        wall.push((t.b.is_none() as u8).to_string());
+        piece
+            .lines
+            .push(vec![piece.points.len(), piece.points.len() + 1]);
+        piece.points.extend([[ga.x, ga.z], end]);
     }
-    let piece = Piece {
-        points,
-        cells,
-        lines: true,
-        data: vec![
-            ("normal_force".into(), "Float64", fnv),
-            ("force".into(), "Float64", fmag),
-            ("wall".into(), "UInt8", wall),
-        ],
-    };
+    let touches = &a.input.touches;
+    piece.cell_data = vec![
+        f64s("normal_force", 1, touches.iter().map(|t| t.normal_force)),
+        vectors("force", touches.iter().map(|t| t.force)),
+        f64s(
+            "force_magnitude",
+            1,
+            touches.iter().map(|t| t.force[0].hypot(t.force[1])),
+        ),
+        vectors("point", touches.iter().map(|t| t.point)),
+        u8s("wall", touches.iter().map(|t| t.b.is_none() as u8)),
+    ];
     let p = dir.join(format!("{prefix}contacts.vtp"));
-    write_piece(&p, &piece)?;
+    write_piece(&p, piece)?;
     files.push(p);
     Ok(files)
 }

@@ -7,6 +7,7 @@ use talus::sim::Simulation;
 
 pub mod mutate;
 pub mod pairs;
+pub mod vtp;
 pub mod wgsl;
 
 /// The talus binary that tests start: `TALUS_BIN` when set (`scripts/gpu-check` runs
