@@ -305,7 +305,16 @@ fn command(command: Command, threads: usize) -> ExitCode {
             force,
             backend,
             quiet,
-        } => run_cmd::cmd_run(scene, out, overrides, resume, from, force, backend, quiet),
+        } => run_cmd::cmd_run(run_cmd::RunArgs {
+            scene,
+            out,
+            overrides,
+            resume,
+            from,
+            force,
+            backend,
+            quiet,
+        }),
         Command::Check {
             scene,
             overrides,

@@ -9,16 +9,29 @@ use std::sync::atomic::Ordering;
 use talus::gpu::device::BackendChoice as Backend;
 use talus::{checkpoint, run};
 
-pub(super) fn cmd_run(
-    path: Option<PathBuf>,
-    out: Option<PathBuf>,
-    overrides: Vec<String>,
-    resume: Option<PathBuf>,
-    from: Option<PathBuf>,
-    force: bool,
-    backend: Backend,
-    quiet: bool,
-) -> Result<(), Failure> {
+/// What `talus run` was asked.
+pub(super) struct RunArgs {
+    pub scene: Option<PathBuf>,
+    pub out: Option<PathBuf>,
+    pub overrides: Vec<String>,
+    pub resume: Option<PathBuf>,
+    pub from: Option<PathBuf>,
+    pub force: bool,
+    pub backend: Backend,
+    pub quiet: bool,
+}
+
+pub(super) fn cmd_run(args: RunArgs) -> Result<(), Failure> {
+    let RunArgs {
+        scene: path,
+        out,
+        overrides,
+        resume,
+        from,
+        force,
+        backend,
+        quiet,
+    } = args;
     let start = match (&resume, &from) {
         (Some(ckpt), _) => checkpoint::read(ckpt, &overrides)?,
         (None, Some(from)) => {
