@@ -53,36 +53,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scene (the built-in default heap when none is given).
-    Run {
-        /// Scene file (JSON). Omit for the built-in default heap.
-        scene: Option<PathBuf>,
-        /// Output folder (default: runs/<scene name>).
-        #[arg(long)]
-        out: Option<PathBuf>,
-        /// Override a scene key, e.g. --set contact.mu=0.3 (repeatable).
-        #[arg(long = "set", value_name = "PATH=VALUE")]
-        overrides: Vec<String>,
-        /// Continue from a checkpoint file (only stop.*, output.* and skin may be --set),
-        /// in the checkpoint's own run folder unless --out says otherwise.
-        #[arg(long, conflicts_with = "scene")]
-        resume: Option<PathBuf>,
-        /// Start from the state of an earlier run (its folder, for its newest
-        /// checkpoint, or a checkpoint) under this scene: the next stage of a
-        /// multi-stage run. The scene may change gravity, the contact law, walls, the
-        /// domain, stop and output; its particles, materials and dt must be the
-        /// earlier run's. Time goes on from the state's.
-        #[arg(long, conflicts_with = "resume", value_name = "RUN_DIR|CHECKPOINT")]
-        from: Option<PathBuf>,
-        /// Clear another run's outputs from the output folder first (otherwise such a
-        /// folder is refused).
-        #[arg(long)]
-        force: bool,
-        #[arg(long, value_enum, default_value_t = Backend::Auto)]
-        backend: Backend,
-        /// No progress output.
-        #[arg(long, short)]
-        quiet: bool,
-    },
+    Run(run_cmd::RunArgs),
     /// Check a scene and print what it would create, without running it.
     Check {
         scene: Option<PathBuf>,
@@ -296,25 +267,7 @@ fn quiet_headless_vulkan() {
 
 fn command(command: Command, threads: usize) -> ExitCode {
     let result = match command {
-        Command::Run {
-            scene,
-            out,
-            overrides,
-            resume,
-            from,
-            force,
-            backend,
-            quiet,
-        } => run_cmd::cmd_run(run_cmd::RunArgs {
-            scene,
-            out,
-            overrides,
-            resume,
-            from,
-            force,
-            backend,
-            quiet,
-        }),
+        Command::Run(args) => run_cmd::cmd_run(args),
         Command::Check {
             scene,
             overrides,

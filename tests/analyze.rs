@@ -1128,17 +1128,9 @@ fn vtk_draws_disks_as_points_and_polygons_as_their_outlines() {
     // Issue 41 item 2: eight disks in a row on a floor and a pentagon resting on them.
     // VTK orders vertices before polygons: the disks first (points at their centres
     // with their radii), then the pentagon (its five world corners, radius 0 at each).
-    let row: Vec<_> = (0..8)
-        .map(|k| json!({ "position": [k as f64 * 0.99, 0.499], "diameter": 1.0 }))
-        .collect();
-    let mut v = common::scene_value(
-        json!({ "law": "overlap_area", "k_n": 1e4, "mu": 0.5 }),
-        json!([{ "kind": "list", "material": "m", "polygon": { "corners": 5 },
-                 "particles": [{ "position": [2.0, 1.45], "diameter": 1.0 }] },
-               { "kind": "list", "material": "m", "particles": row }]),
-    );
-    v["gravity"] = json!({ "g": [0.0, -1.0] });
-    v["walls"] = json!([{ "from": [-5.0, 0.0], "to": [15.0, 0.0] }]);
+    let mut v = common::disks_and_a_pentagon();
+    let (disks, pentagon) = (v["particles"][0].clone(), v["particles"][1].clone());
+    v["particles"] = json!([pentagon, disks]);
     let mut s = common::sim(&v);
     s.advance(400).unwrap();
     let dir = tmp("vtk-mixed");

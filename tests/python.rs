@@ -62,18 +62,10 @@ fn run_python(py: &Path, code: &str, cwd: &Path) -> Result<Value, String> {
 /// `talus run` of a small pile: disks in a row on a floor and a pentagon falling onto
 /// them, with snapshots; the run folder `DIR/run`.
 fn small_run(dir: &Path) -> PathBuf {
-    let row: Vec<_> = (0..8)
-        .map(|k| json!({ "position": [k as f64 * 0.99, 0.499], "diameter": 1.0 }))
-        .collect();
-    let mut v = common::scene_value(
-        json!({ "law": "overlap_area", "k_n": 1e4, "mu": 0.5 }),
-        json!([{ "kind": "list", "material": "m", "particles": row },
-               { "kind": "list", "material": "m", "polygon": { "corners": 5 },
-                 "particles": [{ "position": [2.0, 1.6], "theta": 0.3, "diameter": 1.0 }] }]),
-    );
+    let mut v = common::disks_and_a_pentagon();
+    v["particles"][1]["particles"][0] =
+        json!({ "position": [2.0, 1.6], "theta": 0.3, "diameter": 1.0 });
     v["name"] = json!("python-reader");
-    v["gravity"] = json!({ "g": [0.0, -1.0] });
-    v["walls"] = json!([{ "from": [-5.0, 0.0], "to": [15.0, 0.0] }]);
     v["stop"] = json!({ "time": 0.05 });
     v["output"] = json!({ "snapshot_every": 0.02, "log_every": 0.01, "checkpoint_every": 0 });
     let scene = dir.join("scene.json");

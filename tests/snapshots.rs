@@ -18,17 +18,7 @@ fn tmp(name: &str) -> PathBuf {
 fn written(dir: &Path) -> PathBuf {
     // A row of disks touching each other on a floor, a pentagon resting on them (the
     // snapshot's corner table).
-    let row: Vec<_> = (0..8)
-        .map(|k| json!({ "position": [k as f64 * 0.99, 0.499], "diameter": 1.0 }))
-        .collect();
-    let mut v = common::scene_value(
-        json!({ "law": "overlap_area", "k_n": 1e4, "mu": 0.5 }),
-        json!([{ "kind": "list", "material": "m", "particles": row },
-               { "kind": "list", "material": "m", "polygon": { "corners": 5 },
-                 "particles": [{ "position": [2.0, 1.45], "diameter": 1.0 }] }]),
-    );
-    v["gravity"] = json!({ "g": [0.0, -1.0] });
-    v["walls"] = json!([{ "from": [-5.0, 0.0], "to": [15.0, 0.0] }]);
+    let v = common::disks_and_a_pentagon();
     let mut s = common::sim(&v);
     s.advance(400).unwrap();
     assert!(!s.contacts.is_empty(), "the snapshot should have contacts");

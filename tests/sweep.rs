@@ -3,6 +3,8 @@
 //! others go on, a run made as a Slurm task would make it (`run-one`) bitwise the same
 //! as the same run made locally. Through the binary, on the CPU path.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
@@ -198,8 +200,8 @@ fn a_sweep_runs_every_combination_and_collects_its_statistics() {
     );
     assert!(o.status.success(), "{}", text(&o));
     for f in ["final.bin", "log.csv", "measures.json"] {
-        let a = std::fs::read(dir.join("runs/0002-mu0.6-seed1").join(f)).unwrap();
-        let b = std::fs::read(copy.join("runs/0002-mu0.6-seed1").join(f)).unwrap();
+        let a = common::output_without_provenance(&dir.join("runs/0002-mu0.6-seed1").join(f));
+        let b = common::output_without_provenance(&copy.join("runs/0002-mu0.6-seed1").join(f));
         assert!(a == b, "{f} differs between the local sweep and run-one");
     }
     // Run again, run-one does nothing to a measured run.
@@ -299,7 +301,8 @@ fn a_killed_sweep_continues_where_it_stopped() {
     for (w, k) in runs_of(&whole).iter().zip(runs_of(&killed)) {
         for f in ["final.bin", "log.csv", "measures.json"] {
             assert!(
-                std::fs::read(w.join(f)).unwrap() == std::fs::read(k.join(f)).unwrap(),
+                common::output_without_provenance(&w.join(f))
+                    == common::output_without_provenance(&k.join(f)),
                 "{f} of {} differs from the sweep that was not killed",
                 k.display()
             );

@@ -10,14 +10,35 @@ use talus::gpu::device::BackendChoice as Backend;
 use talus::{checkpoint, run};
 
 /// What `talus run` was asked.
+#[derive(clap::Args)]
 pub(super) struct RunArgs {
+    /// Scene file (JSON). Omit for the built-in default heap.
     pub scene: Option<PathBuf>,
+    /// Output folder (default: runs/<scene name>).
+    #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Override a scene key, e.g. --set contact.mu=0.3 (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
     pub overrides: Vec<String>,
+    /// Continue from a checkpoint file (only stop.*, output.* and skin may be --set),
+    /// in the checkpoint's own run folder unless --out says otherwise.
+    #[arg(long, conflicts_with = "scene")]
     pub resume: Option<PathBuf>,
+    /// Start from the state of an earlier run (its folder, for its newest
+    /// checkpoint, or a checkpoint) under this scene: the next stage of a
+    /// multi-stage run. The scene may change gravity, the contact law, walls, the
+    /// domain, stop and output; its particles, materials and dt must be the
+    /// earlier run's. Time goes on from the state's.
+    #[arg(long, conflicts_with = "resume", value_name = "RUN_DIR|CHECKPOINT")]
     pub from: Option<PathBuf>,
+    /// Clear another run's outputs from the output folder first (otherwise such a
+    /// folder is refused).
+    #[arg(long)]
     pub force: bool,
+    #[arg(long, value_enum, default_value_t = Backend::Auto)]
     pub backend: Backend,
+    /// No progress output.
+    #[arg(long, short)]
     pub quiet: bool,
 }
 

@@ -240,3 +240,45 @@ pub fn polygon_disk_world(
     )
     .map(|g| (g, [ci[0] + g.arm[0], ci[1] + g.arm[1]]))
 }
+
+/// A run's output file as two runs of the same physics must write it alike: the bytes,
+/// less what says which command wrote them (issue 41's provenance): a log's `#` head,
+/// and a snapshot's `provenance` with the checksum that covers it.
+pub fn output_without_provenance(path: &std::path::Path) -> Vec<u8> {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let name = path.file_name().unwrap().to_string_lossy();
+    if name.ends_with(".csv") {
+        let text = String::from_utf8(bytes).unwrap();
+        let body: String = (text.split_inclusive('\n'))
+            .skip_while(|l| l.starts_with('#'))
+            .collect();
+        return body.into_bytes();
+    }
+    if name.ends_with(".json")
+        && let Ok(mut v) = serde_json::from_slice::<Value>(&bytes)
+        && v.get("format").and_then(Value::as_str) == Some("talus-snapshot")
+    {
+        let o = v.as_object_mut().unwrap();
+        o.remove("provenance");
+        o.remove("checksum");
+        return serde_json::to_vec(&v).unwrap();
+    }
+    bytes
+}
+
+/// Eight disks of diameter 1 in a row on a floor wall (gravity 1) and a pentagon of
+/// the same circle resting on them at (2, 1.45): disks among polygons in one scene.
+pub fn disks_and_a_pentagon() -> Value {
+    let row: Vec<_> = (0..8)
+        .map(|k| json!({ "position": [k as f64 * 0.99, 0.499], "diameter": 1.0 }))
+        .collect();
+    let mut v = scene_value(
+        json!({ "law": "overlap_area", "k_n": 1e4, "mu": 0.5 }),
+        json!([{ "kind": "list", "material": "m", "particles": row },
+               { "kind": "list", "material": "m", "polygon": { "corners": 5 },
+                 "particles": [{ "position": [2.0, 1.45], "diameter": 1.0 }] }]),
+    );
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["walls"] = json!([{ "from": [-5.0, 0.0], "to": [15.0, 0.0] }]);
+    v
+}
