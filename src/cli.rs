@@ -456,6 +456,8 @@ fn measure_and_draw(
     let mut n = talus::analyze::write(&a, analysis)?.len();
     n += talus::render::render(&a, pictures, field, width)?.len();
     n += talus::render::vtk::write(&a, pictures)?.len();
+    talus::render::dump::write_named(&a, pictures, "")?;
+    n += 1;
     Ok(n)
 }
 

@@ -8,7 +8,7 @@ use std::f64::consts::PI;
 use std::path::PathBuf;
 use talus::analyze::input::{Grain, Input, Touch};
 use talus::analyze::{self, Analysis, Options};
-use talus::render::{self, Field, ramp};
+use talus::render::{self, Field, diverging, ramp, text};
 use tiny_skia::Pixmap;
 
 const N: usize = 6;
@@ -61,7 +61,7 @@ fn column(units: &str) -> Analysis {
         scene: "column".into(),
         units: units.into(),
         step: 0,
-        time: 0.0,
+        time: 12.5,
         grains,
         touches,
         g: 1.0,
@@ -112,7 +112,8 @@ fn num(line: &str, name: &str) -> f64 {
     attr(line, name).parse().unwrap()
 }
 
-/// A `<text>` of a legend: its role, anchor point, glyph size, anchor and words.
+/// A `<text>` of a legend: its role, anchor point (x, and y on its baseline), glyph
+/// size in pixels to the em, anchor and words.
 struct Text {
     class: String,
     x: f64,
@@ -144,42 +145,45 @@ fn rgb(png: &Pixmap, x: u32, y: u32) -> [u8; 3] {
     [p.red(), p.green(), p.blue()]
 }
 
-/// Asserts that the PNG spells `t` as the SVG places it: every pixel of its 8 × 8
-/// glyphs, scaled, is ink where the glyph has a dot and white elsewhere.
+/// Asserts that the PNG spells `t` as the SVG places it: the words drawn alone on white
+/// at the SVG's place (its font size giving the legend's scale, its y the baseline)
+/// have every inked pixel equal to the picture's, and some ink near the text's colour
+/// (antialiased small glyphs rarely cover a whole pixel).
 fn assert_spelled(png: &Pixmap, t: &Text, colour: [u8; 3]) {
-    let k = (t.size / 8.0) as u32;
-    let n = t.words.chars().count() as u32;
-    let left = if t.end {
-        t.x as u32 - 8 * k * n
-    } else {
-        t.x as u32
-    };
-    for (i, c) in t.words.chars().enumerate() {
-        let glyph = font8x8::legacy::BASIC_LEGACY[c as usize];
-        for (row, bits) in glyph.iter().enumerate() {
-            for col in 0..8u32 {
-                let want = if bits >> col & 1 == 1 {
-                    colour
-                } else {
-                    [255; 3]
-                };
-                let x = left + 8 * k * i as u32 + col * k + k / 2;
-                let y = t.y as u32 + row as u32 * k + k / 2;
-                assert_eq!(
-                    rgb(png, x, y),
-                    want,
-                    "'{c}' of \"{}\" at glyph row {row}, column {col}",
-                    t.words
-                );
+    let k = (t.size / text::font_size(1) as f64).round() as u32;
+    assert!((t.size - text::font_size(k) as f64).abs() < 0.06, "size {}", t.size);
+    let w = text::width(&t.words, k) as i64;
+    let left = if t.end { t.x as i64 - w } else { t.x as i64 };
+    let top = t.y as i64 - text::baseline(k) as i64;
+    let mut alone = Pixmap::new(png.width(), png.height()).unwrap();
+    alone.fill(tiny_skia::Color::WHITE);
+    text::draw(&mut alone, left, top, &t.words, k, colour);
+    let (mut inked, mut solid) = (0, 0);
+    for y in 0..png.height() {
+        for x in 0..png.width() {
+            let want = rgb(&alone, x, y);
+            if want == [255; 3] {
+                continue;
             }
+            inked += 1;
+            let near = (want.iter().zip(colour)).all(|(&a, b)| a.abs_diff(b) <= 60);
+            solid += near as usize;
+            assert_eq!(rgb(png, x, y), want, "\"{}\" at ({x}, {y})", t.words);
         }
     }
+    assert!(inked > 10 && solid > 0, "\"{}\": {inked} pixels inked", t.words);
 }
 
 /// The rows of the PNG that run through the whole colour ramp, as (y, left, right):
 /// ramp(0) at the left end, ramp(1) at the right, and every pixel between the ramp's
 /// colour at its place.
 fn ramp_rows(png: &Pixmap) -> Vec<(u32, u32, u32)> {
+    map_rows(png, ramp)
+}
+
+/// The rows of the PNG that run through the colour map `map` as `ramp_rows` does.
+fn map_rows(png: &Pixmap, map: fn(f64) -> [u8; 3]) -> Vec<(u32, u32, u32)> {
+    let ramp = map;
     let (c0, c1) = (ramp(0.0), ramp(1.0));
     (0..png.height())
         .filter_map(|y| {
@@ -202,7 +206,7 @@ fn the_grains_picture_has_a_colour_bar_of_the_pressure_with_unit_and_range() {
     let words = texts(&bar);
     // The field, its unit (a 2D stress: force per length), and the range of the colours,
     // here the whole range: the 2nd and 98th percentiles of six values are the ends.
-    assert_eq!(text(&words, "label").words, "pressure [m g/sigma]");
+    assert_eq!(text(&words, "label").words, "pressure [m g/σ]");
     let (lo, hi): (f64, f64) = (
         text(&words, "min").words.parse().unwrap(),
         text(&words, "max").words.parse().unwrap(),
@@ -304,8 +308,8 @@ fn every_picture_has_a_length_scale_of_a_round_length_drawn_to_scale() {
         let part = group(&svg, "length-scale");
         let words = texts(&part);
         let label = &text(&words, "label").words;
-        let value: f64 = (label.strip_suffix(" sigma"))
-            .unwrap_or_else(|| panic!("{stem}: \"{label}\" in sigma"))
+        let value: f64 = (label.strip_suffix(" σ"))
+            .unwrap_or_else(|| panic!("{stem}: \"{label}\" in σ"))
             .parse()
             .unwrap();
         let mantissa = value / 10f64.powf(value.log10().floor());
@@ -335,6 +339,11 @@ fn every_picture_has_a_length_scale_of_a_round_length_drawn_to_scale() {
             assert_eq!(rgb(&png, x, y), INK, "{stem}: scale bar at x = {x}");
         }
         assert_spelled(&png, text(&words, "label"), INK);
+        // Above it, the snapshot's time and its number of grains.
+        let caption = texts(&group(&svg, "caption"));
+        let caption = text(&caption, "caption");
+        assert_eq!(caption.words, format!("t = 12.5 √(σ/g) · {N} grains"), "{stem}");
+        assert_spelled(&png, caption, INK);
     }
 }
 
@@ -370,7 +379,7 @@ fn the_force_network_and_stress_crosses_have_keys_in_units() {
     let svg = std::fs::read_to_string(dir.join("stress_crosses.svg")).unwrap();
     let key = group(&svg, "arm-key");
     let words = texts(&key);
-    assert_eq!(text(&words, "label").words, "principal stress [m g/sigma]");
+    assert_eq!(text(&words, "label").words, "principal stress [m g/σ]");
     let values: Vec<&str> = (words.iter().filter(|t| t.class == "value"))
         .map(|t| t.words.as_str())
         .collect();
@@ -437,6 +446,67 @@ fn the_repose_picture_keys_each_reading_with_its_angles() {
     }
 }
 
+/// A pressure of both signs (the top grain pulled up by cohesion) is drawn on the
+/// diverging map, symmetric about zero: red for tension, white for none, blue for
+/// compression, its zero marked under the bar.
+#[test]
+fn a_pressure_of_both_signs_is_drawn_on_a_map_centred_on_zero() {
+    let mut a = column("reduced");
+    // The top contact pulls: the top grain's pressure turns negative.
+    a.input.touches[N - 1].force[1] = -3.0;
+    a.input.touches[N - 1].normal_force = -3.0;
+    let a = analyze::analyze(a.input, &Options::default()).unwrap();
+    let dir = draw(&a, Field::Pressure, "signed");
+    let svg = std::fs::read_to_string(dir.join("grains.svg")).unwrap();
+    let bar = group(&svg, "colour-bar");
+    let words = texts(&bar);
+    let (lo, hi): (f64, f64) = (
+        text(&words, "min").words.parse().unwrap(),
+        text(&words, "max").words.parse().unwrap(),
+    );
+    assert!(lo < 0.0 && (lo + hi).abs() < 1e-9, "symmetric: {lo} .. {hi}");
+    assert_eq!(text(&words, "zero").words, "0");
+    let stops: Vec<&str> = bar[0].split("stop-color=\"").skip(1).collect();
+    for (k, s) in stops.iter().enumerate() {
+        let c = diverging(k as f64 / 8.0);
+        assert!(s.starts_with(&format!("rgb({},{},{})", c[0], c[1], c[2])));
+    }
+    let mid = diverging(0.5);
+    assert!(mid.iter().all(|&v| v > 240), "zero is near white: {mid:?}");
+    // Grains in order, bottom first: the bottom one compressed (blue), the top one in
+    // tension (red).
+    let fills: Vec<[u8; 3]> = (svg.lines().filter(|l| l.starts_with("<circle")))
+        .map(|l| {
+            let v: Vec<u8> = (attr(l, "fill").trim_start_matches("rgb(").trim_end_matches(')'))
+                .split(',')
+                .map(|v| v.parse().unwrap())
+                .collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect();
+    let (bottom, top) = (fills[0], fills[N - 1]);
+    assert!(bottom[2] > bottom[0] + 50, "bottom blue: {bottom:?}");
+    assert!(top[0] > top[2] + 50, "top red: {top:?}");
+    let png = Pixmap::load_png(dir.join("grains.png")).unwrap();
+    assert!(!map_rows(&png, diverging).is_empty(), "the diverging bar in the PNG");
+    assert!(ramp_rows(&png).is_empty(), "no sequential bar");
+    assert_spelled(&png, text(&words, "zero"), INK);
+}
+
+/// P(f/⟨f⟩) is plotted on a logarithmic axis: its y ticks are powers of ten.
+#[test]
+fn the_force_distribution_is_plotted_on_a_log_axis() {
+    let a = column("reduced");
+    let dir = draw(&a, Field::Pressure, "pdf");
+    let svg = std::fs::read_to_string(dir.join("force_distribution.svg")).unwrap();
+    let ticks: Vec<i32> = (svg.split("</text>"))
+        .filter_map(|s| s.rsplit('>').next().map(str::trim))
+        .filter_map(|t| t.strip_prefix("1e").and_then(|e| e.parse().ok()))
+        .collect();
+    assert!(ticks.len() >= 2, "decade ticks: {ticks:?}");
+    assert!(svg.contains("P(f / ⟨f⟩) [-]"), "the axis");
+}
+
 #[test]
 fn every_plot_labels_both_axes_with_units() {
     let a = column("reduced");
@@ -462,5 +532,5 @@ fn every_plot_labels_both_axes_with_units() {
         assert_eq!(units, 2, "{}: two axes with units", p.display());
     }
     let svg = std::fs::read_to_string(dir.join("base_profile.svg")).unwrap();
-    assert!(svg.contains("X = x / l [-]") && svg.contains("S = 2 sigma / (rho g h) [-]"));
+    assert!(svg.contains("X = x / l [-]") && svg.contains("S = 2σ / (ρ g h) [-]"));
 }

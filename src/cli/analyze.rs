@@ -170,6 +170,7 @@ pub(super) fn cmd_render(
     let a = talus::analyze::analyze(input, &opt)?;
     let mut files = talus::render::render(&a, &dir, color, width)?;
     files.extend(talus::render::vtk::write(&a, &dir)?);
+    files.push(talus::render::dump::write_named(&a, &dir, "")?);
     out!("wrote {} files to {}", files.len(), dir.display());
     Ok(())
 }

@@ -679,7 +679,7 @@ pub fn reproduce(
             &path,
             &format!("{id}: vertical stress in row 1, seed means ± one standard deviation"),
             talus::render::plots::Axis::new("X - X_apex", "heap widths"),
-            talus::render::plots::Axis::new("S_zz(1) = 2 sigma_zz / (rho g h)", "-"),
+            talus::render::plots::Axis::new("S_zz(1) = 2σ_zz / (ρ g h)", "-"),
             &bands,
         )?;
     }

@@ -1,11 +1,13 @@
 //! The legend strip under each picture of grains, drawn into the PNG and the SVG alike:
-//! a length scale at the left, and at the right the key to what the picture encodes
+//! at the left the snapshot's time and number of grains over a length scale, and at the
+//! right the key to what the picture encodes
 //! (the colour bar of the field, the width of the force lines, the length of the
 //! stress arms), each with its quantity's name, unit and values. The strip lies below
 //! the heap's view, so it never covers a grain.
 
 use super::text::{self, CELL};
-use super::{Canvas, INK, RAMP, ramp};
+use super::{Canvas, INK, Map, shown};
+use crate::analyze::input::Input;
 use std::fmt::Write as _;
 use tiny_skia::{FillRule, Paint, PathBuilder, Rect, Transform};
 
@@ -120,10 +122,13 @@ impl Canvas {
             Anchor::Start => "start",
             Anchor::End => "end",
         };
+        // SVG places text by its baseline.
         let _ = writeln!(
             self.svg,
-            r#"<text class="{class}" x="{x}" y="{y}" font-family="monospace" font-size="{}" dominant-baseline="hanging" text-anchor="{anchor}" fill="{}">{}</text>"#,
-            CELL * k,
+            r#"<text class="{class}" x="{x}" y="{}" font-family="{}" font-size="{:.1}" text-anchor="{anchor}" fill="{}">{}</text>"#,
+            y + text::baseline(k),
+            text::FAMILY,
+            text::font_size(k),
             rgb(colour),
             escape(s)
         );
@@ -166,7 +171,7 @@ pub(super) fn length_scale(c: &mut Canvas, unit: &str) {
     c.text(
         s.u,
         s.numbers_y,
-        &format!("{value} {unit}"),
+        &format!("{value} {}", shown(unit)),
         Anchor::Start,
         INK,
         "label",
@@ -174,8 +179,24 @@ pub(super) fn length_scale(c: &mut Canvas, unit: &str) {
     c.svg.push_str("</g>\n");
 }
 
-/// The colour ramp from `lo` (left, ramp(0)) to `hi` (right, ramp(1)), `label` above it.
-pub(super) fn colour_bar(c: &mut Canvas, label: &str, lo: f64, hi: f64) {
+/// What the picture shows, above the length scale: the snapshot's time in the scene's
+/// units (s, or √(σ/g) in reduced units) and its number of grains, fixed ones included.
+pub(super) fn caption(c: &mut Canvas, input: &Input) {
+    let s = Strip::of(c);
+    let unit = if input.units == "si" { "s" } else { "√(σ/g)" };
+    let words = format!(
+        "t = {} {unit} · {} grains",
+        number(input.time),
+        input.grains.len()
+    );
+    c.svg.push_str("<g id=\"caption\">\n");
+    c.text(s.u, s.label_y, &words, Anchor::Start, INK, "caption");
+    c.svg.push_str("</g>\n");
+}
+
+/// The colour map from `lo` (left, the map's 0) to `hi` (right, its 1), `label` above
+/// it; a diverging map has its zero marked under the middle.
+pub(super) fn colour_bar(c: &mut Canvas, label: &str, lo: f64, hi: f64, map: Map) {
     let s = Strip::of(c);
     if s.x1 <= s.x0 + 1 {
         return;
@@ -183,11 +204,12 @@ pub(super) fn colour_bar(c: &mut Canvas, label: &str, lo: f64, hi: f64) {
     let n = s.x1 - s.x0;
     c.svg
         .push_str("<g id=\"colour-bar\">\n<defs><linearGradient id=\"ramp\">");
-    for (k, col) in RAMP.iter().enumerate() {
+    let stops = map.stops();
+    for (k, col) in stops.iter().enumerate() {
         let _ = write!(
             c.svg,
             r#"<stop offset="{:.4}" stop-color="{}"/>"#,
-            k as f64 / (RAMP.len() - 1) as f64,
+            k as f64 / (stops.len() - 1) as f64,
             rgb(*col)
         );
     }
@@ -197,13 +219,13 @@ pub(super) fn colour_bar(c: &mut Canvas, label: &str, lo: f64, hi: f64) {
         r#"<rect x="{}" y="{}" width="{n}" height="{}" fill="url(#ramp)"/>"#,
         s.x0, s.bar_y, s.u
     );
-    // In the PNG one column per pixel, each the ramp's colour at its place.
+    // In the PNG one column per pixel, each the map's colour at its place.
     let mut paint = Paint {
         anti_alias: false,
         ..Default::default()
     };
     for i in 0..n {
-        let col = ramp(i as f64 / (n - 1) as f64);
+        let col = map.colour(i as f64 / (n - 1) as f64);
         paint.set_color_rgba8(col[0], col[1], col[2], 255);
         if let Some(r) = Rect::from_xywh((s.x0 + i) as f32, s.bar_y as f32, 1.0, s.u as f32) {
             c.pixmap.fill_rect(r, &paint, Transform::identity(), None);
@@ -212,6 +234,12 @@ pub(super) fn colour_bar(c: &mut Canvas, label: &str, lo: f64, hi: f64) {
     c.text(s.x1, s.label_y, label, Anchor::End, INK, "label");
     c.text(s.x0, s.numbers_y, &number(lo), Anchor::Start, INK, "min");
     c.text(s.x1, s.numbers_y, &number(hi), Anchor::End, INK, "max");
+    if map == Map::Diverging {
+        let mid = s.x0 + n / 2;
+        c.rect(mid, s.bar_y + s.u, s.k.max(1), s.u / 4, INK);
+        let half = text::width("0", s.k) / 2;
+        c.text(mid - half, s.numbers_y, "0", Anchor::Start, INK, "zero");
+    }
     c.svg.push_str("</g>\n");
 }
 

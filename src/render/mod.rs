@@ -6,9 +6,10 @@
 //! grains a legend strip (`legend`) gives a length scale and the key to its colours or
 //! line sizes, with units.
 
+pub mod dump;
 mod legend;
 pub mod plots;
-mod text;
+pub mod text;
 pub mod vtk;
 
 use crate::analyze::Analysis;
@@ -55,7 +56,8 @@ pub enum Field {
     Plain,
 }
 
-/// Perceptually even colours from dark blue through green to yellow (viridis, sampled).
+/// Perceptually even colours from dark blue through green to yellow (viridis, sampled),
+/// for fields of one sign.
 const RAMP: [[u8; 3]; 9] = [
     [68, 1, 84],
     [71, 44, 122],
@@ -68,36 +70,89 @@ const RAMP: [[u8; 3]; 9] = [
     [253, 231, 37],
 ];
 
-/// The colour of `t` ∈ [0, 1] on the grains' colour scale (the colour bar's ramp, left
-/// to right); NaN is ramp(0).
+/// Colours for a field of both signs, centred on zero (ColorBrewer's RdBu, 9 classes):
+/// red for negative (tension) through near-white at zero to blue for positive
+/// (compression), the colours of the stress crosses.
+const DIVERGING: [[u8; 3]; 9] = [
+    [178, 24, 43],
+    [214, 96, 77],
+    [244, 165, 130],
+    [253, 219, 199],
+    [247, 247, 247],
+    [209, 229, 240],
+    [146, 197, 222],
+    [67, 147, 195],
+    [33, 102, 172],
+];
+
+/// Which colour map a picture's field is drawn in.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Map {
+    /// viridis, from the field's low end to its high end.
+    Sequential,
+    /// red–white–blue, symmetric about zero (white).
+    Diverging,
+}
+
+impl Map {
+    fn stops(self) -> &'static [[u8; 3]; 9] {
+        match self {
+            Map::Sequential => &RAMP,
+            Map::Diverging => &DIVERGING,
+        }
+    }
+
+    /// The colour of `t` ∈ [0, 1] on this map (the colour bar, left to right), mixed
+    /// linearly between its stops; NaN is the colour of 0.
+    pub fn colour(self, t: f64) -> [u8; 3] {
+        let stops = self.stops();
+        let t = if t.is_finite() {
+            t.clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let x = t * (stops.len() - 1) as f64;
+        let k = (x.floor() as usize).min(stops.len() - 2);
+        let f = x - k as f64;
+        let mix = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
+        let (a, b) = (stops[k], stops[k + 1]);
+        [mix(a[0], b[0]), mix(a[1], b[1]), mix(a[2], b[2])]
+    }
+}
+
+/// The colour of `t` ∈ [0, 1] on the sequential map (`Map::Sequential`).
 pub fn ramp(t: f64) -> [u8; 3] {
-    let t = if t.is_finite() {
-        t.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    let x = t * (RAMP.len() - 1) as f64;
-    let k = (x.floor() as usize).min(RAMP.len() - 2);
-    let f = x - k as f64;
-    let mix = |a: u8, b: u8| (a as f64 + f * (b as f64 - a as f64)).round() as u8;
-    [
-        mix(RAMP[k][0], RAMP[k + 1][0]),
-        mix(RAMP[k][1], RAMP[k + 1][1]),
-        mix(RAMP[k][2], RAMP[k + 1][2]),
-    ]
+    Map::Sequential.colour(t)
+}
+
+/// The colour of `t` ∈ [0, 1] on the diverging map: 0.5 is zero.
+pub fn diverging(t: f64) -> [u8; 3] {
+    Map::Diverging.colour(t)
+}
+
+/// A unit as the pictures write it: the reduced units' length, the grain diameter
+/// `sigma` in files, is σ.
+pub(crate) fn shown(unit: &str) -> &str {
+    match unit {
+        "sigma" => "σ",
+        u => u,
+    }
 }
 
 /// What the colours of a picture mean: `label` (the quantity and its unit) from `lo`
-/// at ramp(0) to `hi` at ramp(1).
+/// at the map's 0 to `hi` at its 1.
 struct Scale {
     label: String,
     lo: f64,
     hi: f64,
+    map: Map,
 }
 
 /// The value of `field` per grain, scaled to [0, 1] (by its 2nd and 98th percentiles,
 /// so that a few extreme grains do not wash out the rest), and the scale that maps it
-/// (None for one colour).
+/// (None for one colour). A pressure that takes both signs between those percentiles
+/// (cohesive grains in tension) is drawn on the diverging map, symmetric about zero,
+/// so that white is no stress and the two signs read apart.
 fn field_values(a: &Analysis, field: Field) -> (Vec<f64>, Option<Scale>) {
     let raw: Vec<f64> = a
         .input
@@ -116,13 +171,18 @@ fn field_values(a: &Analysis, field: Field) -> (Vec<f64>, Option<Scale>) {
         .collect();
     let label = match field {
         // The grain's stress is a 2D stress: force per length (CSV `sigma_* [f/l]`).
-        Field::Pressure => format!("pressure [{}/{}]", a.input.force_unit, a.input.length_unit),
+        Field::Pressure => format!(
+            "pressure [{}/{}]",
+            a.input.force_unit,
+            shown(&a.input.length_unit)
+        ),
         Field::Contacts => "contacts [-]".into(),
         Field::Orientation => {
             let scale = Scale {
                 label: "long axis from horizontal [rad]".into(),
                 lo: 0.0,
                 hi: std::f64::consts::PI,
+                map: Map::Sequential,
             };
             return (raw, Some(scale));
         }
@@ -135,13 +195,20 @@ fn field_values(a: &Analysis, field: Field) -> (Vec<f64>, Option<Scale>) {
     }
     let q = |p: f64| sorted[((sorted.len() - 1) as f64 * p).round() as usize];
     let (mut lo, mut hi) = (q(0.02), q(0.98));
+    let map = if field == Field::Pressure && lo < 0.0 && hi > 0.0 {
+        let m = hi.max(-lo);
+        (lo, hi) = (-m, m);
+        Map::Diverging
+    } else {
+        Map::Sequential
+    };
     if hi <= lo {
         // One value for all: it sits mid-scale, on a bar around it.
         let d = if lo == 0.0 { 1.0 } else { 0.5 * lo.abs() };
         (lo, hi) = (lo - d, hi + d);
     }
     let values = raw.iter().map(|v| (v - lo) / (hi - lo)).collect();
-    (values, Some(Scale { label, lo, hi }))
+    (values, Some(Scale { label, lo, hi, map }))
 }
 
 /// World (length units, z up) to picture (pixels, y down).
@@ -332,20 +399,22 @@ pub fn render(
     let line = (0.04 * a.summary.mean_diameter * view.scale).clamp(0.3, 2.0) as f32;
     // Grains coloured by the field.
     let (values, scale) = field_values(a, field);
+    let map = scale.as_ref().map_or(Map::Sequential, |s| s.map);
     let mut c = Canvas::new(view)?;
     for (k, g) in a.input.grains.iter().enumerate() {
         let fill = if g.fixed {
             [150, 150, 150]
         } else if values[k].is_finite() {
-            ramp(values[k])
+            map.colour(values[k])
         } else {
             GREY
         };
         c.shape(g, fill, Some(INK), 0.5 * line);
     }
     legend::length_scale(&mut c, &a.input.length_unit);
+    legend::caption(&mut c, &a.input);
     if let Some(s) = scale {
-        legend::colour_bar(&mut c, &s.label, s.lo, s.hi);
+        legend::colour_bar(&mut c, &s.label, s.lo, s.hi, s.map);
     }
     c.save(dir, "grains", &mut files)?;
     // Force network: grains faint, each contact a line from centre to centre (to the
@@ -382,6 +451,7 @@ pub fn render(
         legend::width_key(&mut c, &label, fmax, wmax);
     }
     legend::length_scale(&mut c, &a.input.length_unit);
+    legend::caption(&mut c, &a.input);
     c.save(dir, "forces", &mut files)?;
     // Principal stresses of the moving-average windows: crosses at the window centres
     // (every `row` height along each row), arms along φ and φ + π/2 proportional to σ_max
@@ -422,7 +492,8 @@ pub fn render(
         if smax > 0.0 {
             let label = format!(
                 "principal stress [{}/{}]",
-                a.input.force_unit, a.input.length_unit
+                a.input.force_unit,
+                shown(&a.input.length_unit)
             );
             let arms = [(COMPRESSION, "compression"), (TENSION, "tension")];
             let thick = (1.5 * line).round().max(1.0) as u32;
@@ -430,6 +501,7 @@ pub fn render(
         }
     }
     legend::length_scale(&mut c, &a.input.length_unit);
+    legend::caption(&mut c, &a.input);
     c.save(dir, "stress_crosses", &mut files)?;
     repose_lines(a, view, line)?.save(dir, "repose", &mut files)?;
     files.extend(plots::write_plots(a, dir)?);
@@ -477,6 +549,7 @@ fn repose_lines(a: &Analysis, view: View, line: f32) -> Result<Canvas, RenderErr
         key.push((colour, format!("{name} {}/{}", deg(l), deg(r))));
     }
     legend::length_scale(&mut c, &a.input.length_unit);
+    legend::caption(&mut c, &a.input);
     legend::line_key(&mut c, "angle of repose [deg], left/right", &key);
     Ok(c)
 }

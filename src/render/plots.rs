@@ -1,7 +1,8 @@
 //! Plots of the profiles as SVG (plotters): S_zz and S_xx along the base against
 //! X = x/l (paper 000 Fig. 3, 6, 14), the force on fixed base particles (paper 001
-//! Fig. 3b), P(f/⟨f⟩), f(θ), and P(φ) of the principal stress directions (paper 004
-//! Fig. 5). The base profiles carry bands of ± one bootstrap standard error
+//! Fig. 3b), P(f/⟨f⟩) on a logarithmic axis (the exponential tail of the force
+//! distribution is a straight line there, as the field plots it), f(θ), and P(φ) of
+//! the principal stress directions (paper 004 Fig. 5). The base profiles carry bands of ± one bootstrap standard error
 //! (`analyze::spread`).
 
 use super::RenderError;
@@ -145,6 +146,82 @@ fn plot_with_bands(
     write_atomic(path, text.as_bytes()).map_err(RenderError::write(path))
 }
 
+/// One line plot on a logarithmic y axis: points with y ≤ 0 (an empty bin) are left
+/// out, since they have no place on it; the axis spans the positive points' decades.
+fn plot_log_y(
+    path: &Path,
+    title: &str,
+    x: Axis,
+    y: Axis,
+    series: &[Series],
+) -> Result<(), RenderError> {
+    let shown = |p: &&(f64, f64)| p.0.is_finite() && p.1.is_finite() && p.1 > 0.0;
+    let pts = series.iter().flat_map(|s| s.2.iter()).filter(shown);
+    let (mut x0, mut x1, mut y0, mut y1) = (
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    );
+    for &(x, y) in pts {
+        x0 = x0.min(x);
+        x1 = x1.max(x);
+        y0 = y0.min(y);
+        y1 = y1.max(y);
+    }
+    if x1.partial_cmp(&x0) != Some(std::cmp::Ordering::Greater) {
+        (x0, x1) = (0.0, 1.0);
+    }
+    // Whole decades around the points (one decade for none or one value).
+    let (y0, y1) = if y1 >= y0 {
+        (
+            10f64.powf(y0.log10().floor()),
+            10f64.powf((y1.log10() + 1e-9).ceil().max(y0.log10().floor() + 1.0)),
+        )
+    } else {
+        (0.1, 1.0)
+    };
+    x0 = x0.min(0.0);
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (800, 500)).into_drawing_area();
+        let e = |e: &dyn std::fmt::Display| RenderError::Plot {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        };
+        root.fill(&WHITE).map_err(|x| e(&x))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+            .map_err(|x| e(&x))?;
+        chart
+            .configure_mesh()
+            .x_desc(x.label())
+            .y_desc(y.label())
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(|x| e(&x))?;
+        for (name, color, data) in series {
+            let c = *color;
+            let line = data.iter().filter(shown).copied();
+            chart
+                .draw_series(LineSeries::new(line, c.stroke_width(2)))
+                .map_err(|x| e(&x))?
+                .label(*name)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
+                });
+            let dots = data.iter().filter(shown).map(|&p| Circle::new(p, 3, c.filled()));
+            chart.draw_series(dots).map_err(|x| e(&x))?;
+        }
+        root.present().map_err(|x| e(&x))?;
+    }
+    write_atomic(path, text.as_bytes()).map_err(RenderError::write(path))
+}
+
 pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError> {
     let o = &a.summary.outline;
     let sc = a.summary.stress_scale;
@@ -167,7 +244,7 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
             a.summary.scene
         ),
         Axis::new("X = x / l", "-"),
-        Axis::new("S = 2 sigma / (rho g h)", "-"),
+        Axis::new("S = 2σ / (ρ g h)", "-"),
         &[
             (
                 "S_zz",
@@ -208,7 +285,7 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
                 a.summary.scene, load.spread.verdict, load.spread.dip_z
             ),
             Axis::new("X = x / l", "-"),
-            Axis::new("F_B / m g", "-"),
+            Axis::new("F_B / (m g)", "-"),
             &[
                 (
                     "each",
@@ -229,11 +306,11 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
         files.push(p);
     }
     let p = dir.join("force_distribution.svg");
-    plot(
+    plot_log_y(
         &p,
         "normal forces between grains",
-        Axis::new("f / <f>", "-"),
-        Axis::new("P(f / <f>)", "-"),
+        Axis::new("f / ⟨f⟩", "-"),
+        Axis::new("P(f / ⟨f⟩)", "-"),
         &[("P", BLACK, a.force_pdf.clone())],
     )?;
     files.push(p);
@@ -241,8 +318,8 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
     plot(
         &p,
         "principal stress directions of the grains",
-        Axis::new("phi", "rad"),
-        Axis::new("P(phi)", "1/rad"),
+        Axis::new("φ", "rad"),
+        Axis::new("P(φ)", "1/rad"),
         &[("P", BLACK, a.principal_directions.clone())],
     )?;
     files.push(p);
@@ -251,8 +328,8 @@ pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError
         plot(
             &p,
             "orientation of the long axes",
-            Axis::new("theta", "rad"),
-            Axis::new("f(theta)", "1/rad"),
+            Axis::new("θ", "rad"),
+            Axis::new("f(θ)", "1/rad"),
             &[("f", BLACK, a.orientation.clone())],
         )?;
         files.push(p);
@@ -276,7 +353,7 @@ pub fn write_profiles(
         path,
         title,
         Axis::new("X - X_apex", "heap widths"),
-        Axis::new("S_zz(1) = 2 sigma_zz / (rho g h)", "-"),
+        Axis::new("S_zz(1) = 2σ_zz / (ρ g h)", "-"),
         &series,
     )
 }
@@ -296,7 +373,7 @@ pub fn write_janssen(
         if let Some(j) = fit {
             let deepest = data.iter().map(|p| p.0).fold(0.0, f64::max);
             names.push(format!(
-                "{name}: fit, sigma_m {:.3}, h_s {:.2} W",
+                "{name}: fit, σ_m {:.3}, h_s {:.2} W",
                 j.sigma_m, j.h_s
             ));
             lines.push(
@@ -314,7 +391,7 @@ pub fn write_janssen(
         path,
         title,
         Axis::new("depth / W", "-"),
-        Axis::new("(sigma_xx + sigma_zz) / (rho g W)", "-"),
+        Axis::new("(σ_xx + σ_zz) / (ρ g W)", "-"),
         &series,
     )
 }

@@ -203,7 +203,7 @@ pub fn collection(entries: &[(f64, String, String)]) -> String {
 
 /// Each grain's net contact force and torque about its centre (2D: out of the plane,
 /// counter-clockwise in the x–z plane positive), from the snapshot's contacts.
-fn net_loads(a: &Analysis) -> Vec<([f64; 2], f64)> {
+pub(super) fn net_loads(a: &Analysis) -> Vec<([f64; 2], f64)> {
     let grains = &a.input.grains;
     let mut loads = vec![([0.0; 2], 0.0); grains.len()];
     let mut add = |k: usize, f: [f64; 2], point: [f64; 2]| {

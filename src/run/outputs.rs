@@ -85,7 +85,13 @@ impl Outputs {
                 provenance: provenance.clone(),
             },
             vtk: Vtk {
-                every: if o.vtk { snapshots } else { Schedule::NEVER },
+                every: if o.vtk || o.dump {
+                    snapshots
+                } else {
+                    Schedule::NEVER
+                },
+                vtk: o.vtk,
+                dump: o.dump,
                 dir: snap_dir,
                 scene: serde_json::to_value(scene).expect("a scene always serialises"),
                 entries: Vec::new(),
@@ -274,9 +280,12 @@ impl Output for Snapshots {
 
 /// With `output.vtk`, beside each snapshot: its grains and contacts as VTK PolyData
 /// (`snap_SSSSSSSSSS_grains.vtp`, `_contacts.vtp`), and `snapshots.pvd` listing every
-/// one this run wrote, for ParaView.
+/// one this run wrote, for ParaView; with `output.dump`, its grains as a LAMMPS-style
+/// dump (`snap_SSSSSSSSSS_grains.dump`) for OVITO. Both from one analysis of the state.
 pub struct Vtk {
     every: Schedule,
+    vtk: bool,
+    dump: bool,
     dir: PathBuf,
     /// The scene as `scene.json` holds it: gravity and friction for the analysis.
     scene: serde_json::Value,
@@ -305,6 +314,12 @@ impl Output for Vtk {
         let time = input.time;
         let a = analyze::analyze(input, &analyze::Options::default())?;
         let prefix = format!("{stem}_");
+        if self.dump {
+            render::dump::write_named(&a, &self.dir, &prefix)?;
+        }
+        if !self.vtk {
+            return Ok(());
+        }
         render::vtk::write_named(&a, &self.dir, &prefix)?;
         self.entries.push((
             time,

@@ -386,6 +386,10 @@ pub struct Output {
     /// `snapshots.pvd` listing them in time).
     #[serde(default)]
     pub vtk: bool,
+    /// Also write each snapshot as a LAMMPS-style text dump for OVITO
+    /// (`snapshots/snap_SSSSSSSSSS_grains.dump`; `render::dump`).
+    #[serde(default)]
+    pub dump: bool,
 }
 
 impl Default for Output {
@@ -395,6 +399,7 @@ impl Default for Output {
             checkpoint_every: None,
             log_every: 0.0,
             vtk: false,
+            dump: false,
         }
     }
 }

@@ -106,14 +106,14 @@ const PROFILES: [Profile; 3] = [
         name: "szz_row1",
         title: "S_zz in row 1, seed average ± one standard deviation",
         x: plots::Axis::new("X - X_apex", "heap widths"),
-        y: plots::Axis::new("S_zz(1) = 2 sigma_zz / (rho g h)", "-"),
+        y: plots::Axis::new("S_zz(1) = 2σ_zz / (ρ g h)", "-"),
         of: |m| &m.szz_row1,
     },
     Profile {
         name: "base_force",
         title: "Force on the fixed base particles, seed average ± one standard deviation",
         x: plots::Axis::new("x - x_apex", "mean diameters"),
-        y: plots::Axis::new("F_B / m g", "-"),
+        y: plots::Axis::new("F_B / (m g)", "-"),
         of: |m| &m.base_force,
     },
     Profile {
