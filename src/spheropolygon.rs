@@ -12,7 +12,7 @@
 //!
 //! Issue 15, first step: the shape, its mass properties and the sub-contacts. The law
 //! (Hertz with cohesion, SPEC 2.4) is `law::hertz_cohesive`; neither is wired into scenes
-//! or the GPU path yet (README, "not done").
+//! or the GPU path yet (docs/GUIDE.md, "Not done yet").
 
 use crate::shape::P2;
 use std::f64::consts::PI;

@@ -208,3 +208,73 @@ fn the_python_reader_refuses_a_damaged_snapshot() {
     let code = "import json, talus\nprint(json.dumps(len(talus.read_snapshot('run/final.json', verify=False)['id'])))";
     assert_eq!(run_python(&py, code, &dir).unwrap(), json!(9));
 }
+
+/// The README's install, as a user does it (issue 41): `pip install ./python` into a
+/// fresh virtual environment (numpy from the system's site packages, no network: the
+/// build uses the system's setuptools), then the reader imported from another folder
+/// without `PYTHONPATH`.
+#[test]
+fn pip_installs_the_reader_into_a_fresh_venv() {
+    let Some(py) = python() else { return };
+    let has = |module: &str| {
+        Command::new(&py)
+            .args(["-c", &format!("import {module}")])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !(has("ensurepip") && has("setuptools")) {
+        if std::env::var("TALUS_REQUIRE_PYTHON").as_deref() == Ok("1") {
+            panic!("no venv or setuptools (TALUS_REQUIRE_PYTHON=1): apt-get install python3-venv python3-setuptools");
+        }
+        eprintln!("skipped: no venv or setuptools (apt-get install python3-venv python3-setuptools)");
+        return;
+    }
+    let dir = tmp("venv");
+    let venv = dir.join("venv");
+    let o = Command::new(&py)
+        .args(["-m", "venv", "--system-site-packages"])
+        .arg(&venv)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "venv: {}", String::from_utf8_lossy(&o.stderr));
+    // A copy of the package, so that the build leaves nothing in the checkout.
+    let src = dir.join("python");
+    std::fs::create_dir_all(src.join("talus")).unwrap();
+    let repo = Path::new(env!("CARGO_MANIFEST_DIR")).join("python");
+    for f in ["pyproject.toml", "README.md"] {
+        std::fs::copy(repo.join(f), src.join(f)).unwrap();
+    }
+    for e in std::fs::read_dir(repo.join("talus")).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "py") {
+            std::fs::copy(&p, src.join("talus").join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    let o = Command::new(venv.join("bin/pip"))
+        .args(["install", "-q", "--no-index", "--no-build-isolation"])
+        .arg(&src)
+        .env_remove("PYTHONPATH")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "pip install: {}", String::from_utf8_lossy(&o.stderr));
+    small_run(&dir);
+    let o = Command::new(venv.join("bin/python"))
+        .args([
+            "-c",
+            "import talus; s = talus.read_snapshot('run/final.json'); print(s['position'].shape)",
+        ])
+        .env_remove("PYTHONPATH")
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(String::from_utf8_lossy(&o.stdout).trim(), "(9, 2)");
+    // Installed, not found beside it: the module lives in the venv.
+    let o = Command::new(venv.join("bin/python"))
+        .args(["-c", "import talus; print(talus.__file__)"])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let at = String::from_utf8_lossy(&o.stdout);
+    assert!(at.contains("site-packages"), "{at}");
+}

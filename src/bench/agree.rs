@@ -44,7 +44,7 @@ pub const DISKS: Tolerance = Tolerance {
 
 /// The tolerances for the polygon pile. Its faces start exactly touching, where the
 /// GPU's corners (whole position units) are right to 1e-3 only from A/l ≈ 2e-6 d
-/// (README, "Precision"), and the 60° pile slumps a little, stick–slip deciding which
+/// (docs/GUIDE.md, "Precision"), and the 60° pile slumps a little, stick–slip deciding which
 /// faces slide: one pair in a thousand parts from its twin by a few per cent of the mean
 /// force while the typical pair and the weight carried stay within SPEC 3's 1e-3.
 /// Measured on lavapipe after 300 steps: 3·10⁴ 12-gons at 6.9e-5 d, 6.1e-2 worst,

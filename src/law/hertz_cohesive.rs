@@ -16,7 +16,7 @@
 //!   repulsive part, so a contact held only by cohesion (δ ≤ 0) has no friction.
 //!
 //! Issue 15, first step: the law as a function with its tests; not yet selectable in
-//! scenes (README, "not done").
+//! scenes (docs/GUIDE.md, "Not done yet").
 
 use super::tangential::{coulomb_spring, spring_energy};
 use super::{ContactInput, ContactOutput};

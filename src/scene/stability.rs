@@ -153,7 +153,7 @@ fn gpu_resolution_warning(scene: &Scene, law: &ContactLaw) -> Option<String> {
         return None;
     }
     Some(format!(
-        "resting contacts overlap by about {overlap:.2e} (m g/k_n for the lightest particle); the GPU path resolves overlaps to about {:.1e} (whole position units of cell/2^30{}), so its contact forces are right to 1e-3 only from overlaps of {limit:.1e} up and may be off by ~{:.0e} here (README, \"Precision\"); the CPU path (f64) has no such limit",
+        "resting contacts overlap by about {overlap:.2e} (m g/k_n for the lightest particle); the GPU path resolves overlaps to about {:.1e} (whole position units of cell/2^30{}), so its contact forces are right to 1e-3 only from overlaps of {limit:.1e} up and may be off by ~{:.0e} here (docs/GUIDE.md, \"Precision\"); the CPU path (f64) has no such limit",
         resolution * unit,
         if matches!(law, ContactLaw::OverlapArea(_)) {
             ", polygon corners"
