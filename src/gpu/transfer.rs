@@ -544,17 +544,6 @@ impl GpuSimulation {
         }
     }
 
-    /// Overwrites the particle state on the device (tests).
-    pub fn upload_particles(&mut self, p: &Particles) {
-        let (s, pr) = to_device(p, self.origin, self.params.cell_size);
-        let s_buf = self.buffers.state.clone();
-        let p_buf = self.buffers.props.clone();
-        let ids_buf = self.buffers.ids.clone();
-        self.write_buffer(&s_buf, &s);
-        self.write_buffer(&p_buf, &pr);
-        self.write_buffer(&ids_buf, &(0..s.len() as u32).collect::<Vec<_>>());
-    }
-
     /// Whether rebuilds sort the particles in memory by cell (default: yes). No result
     /// depends on it (tests compare both).
     pub fn set_reorder(&mut self, reorder: bool) {
