@@ -68,6 +68,11 @@ const READING_SLIP_DAMPING: u32 = 1u;
 const READING_CONTACT_ARM: u32 = 2u;
 // Candidates of one source looked at per step.
 const INSERT_WINDOW: u32 = 4u;
+// Gear values per degree of freedom (State.q; src/state.rs).
+const GEAR_VALUES: u32 = 6u;
+// Slots of the spring-dashpot law's table per pair of materials (Params.pair_law holds
+// two vec4 per slot).
+const MAX_PAIR_SLOTS: u32 = 64u;
 
 struct Params {
     n_cap: u32,
@@ -144,14 +149,14 @@ struct Params {
     reading: u32,
     pad_pair1: u32,
     pad_pair2: u32,
-    pair_law: array<vec4<f32>, 128>,
+    pair_law: array<vec4<f32>, 2u * MAX_PAIR_SLOTS>,
 };
 
 // Dynamic state: q[0] = (rem_x, rem_z, rem_theta, 0) with the position's remainder in
 // units (position.wgsl) and the orientation's in turn units (orientation.wgsl),
 // q[k] = (dt^k/k!) d^k/dt^k in length units and radians.
 struct State {
-    q: array<vec4<f32>, 6>,
+    q: array<vec4<f32>, GEAR_VALUES>,
     anchor: vec2<i32>,
     frac: vec2<u32>,
     turn: u32,
@@ -374,13 +379,17 @@ fn tangent(n: vec2<f32>) -> vec2<f32> {
     return vec2<f32>(-n.y, n.x);
 }
 
-// Slot hash of a pair for the spring table (murmur3's 32-bit finaliser over both ids).
+// Slot hash of a pair for the spring table (host twin src/gpu/layout.rs `hash_pair`):
+// both ids multiplied by odd constants, mixed by the buckets' finaliser.
+const PAIR_HASH_I: u32 = 0x9E3779B1u;
+const PAIR_HASH_J_ADD: u32 = 0x7F4A7C15u;
+const PAIR_HASH_J: u32 = 0x85EBCA77u;
 fn hash_pair(i: u32, j: u32) -> u32 {
-    var h = (i * 0x9E3779B1u) ^ ((j + 0x7F4A7C15u) * 0x85EBCA77u);
+    var h = (i * PAIR_HASH_I) ^ ((j + PAIR_HASH_J_ADD) * PAIR_HASH_J);
     h ^= h >> 16u;
-    h *= 0x7FEB352Du;
+    h *= HASH_MIX_1;
     h ^= h >> 15u;
-    h *= 0x846CA68Bu;
+    h *= HASH_MIX_2;
     h ^= h >> 16u;
     return h;
 }

@@ -7,17 +7,24 @@
 // follows on the device at once, with no insertion before its prediction.
 override AHEAD: bool = false;
 
+// The corrector's coefficients c_k (src/integrate/gear.rs `CORRECTOR`); c2 = 1.
+const GEAR_C0: f32 = 3.0 / 20.0;
+const GEAR_C1: f32 = 251.0 / 360.0;
+const GEAR_C3: f32 = 11.0 / 18.0;
+const GEAR_C4: f32 = 1.0 / 6.0;
+const GEAR_C5: f32 = 1.0 / 60.0;
+
 fn correct_one(s: ptr<function, State>, accel: vec4<f32>) {
     let half_dt2 = 0.5 * params.dt * params.dt;
     let delta = half_dt2 * accel - (*s).q[2];
-    turn_by(s, (3.0 / 20.0) * delta.z);
-    displace(s, (3.0 / 20.0) * delta.xy);
-    (*s).q[1] += (251.0 / 360.0) * delta;
+    turn_by(s, GEAR_C0 * delta.z);
+    displace(s, GEAR_C0 * delta.xy);
+    (*s).q[1] += GEAR_C1 * delta;
     renormalize_q1(s);
     (*s).q[2] += delta;
-    (*s).q[3] += (11.0 / 18.0) * delta;
-    (*s).q[4] += (1.0 / 6.0) * delta;
-    (*s).q[5] += (1.0 / 60.0) * delta;
+    (*s).q[3] += GEAR_C3 * delta;
+    (*s).q[4] += GEAR_C4 * delta;
+    (*s).q[5] += GEAR_C5 * delta;
 }
 
 @compute @workgroup_size(WG)

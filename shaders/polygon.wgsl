@@ -820,7 +820,7 @@ fn polygons_ij(i: u32, j: u32) -> AreaContact {
     let o = offset_ij(i, j);
     // Centres more than 1.5 cells apart cannot touch (and their corners would not fit
     // an i32 in the frame).
-    if (!o.near || any(abs(o.d) > vec2<i32>(1610612736))) { return no_contact(); }
+    if (!o.near || any(abs(o.d) > vec2<i32>(FRAC_ONE + FRAC_ONE / 2))) { return no_contact(); }
     var p = load_outline(i, o.d, o.e);
     var q = load_outline(j, vec2<i32>(0), vec2<f32>(0.0));
     let h = o.d / vec2<i32>(2);
@@ -1026,7 +1026,7 @@ fn circle_crossing(p: ptr<function, Outline>, m: u32, k: u32, r: f32) -> vec3<f3
 // length units with the force point relative to centre i. Frame: the disk's centre.
 fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
     let o = offset_ij(poly, disk);
-    if (!o.near || any(abs(o.d) > vec2<i32>(1610612736))) { return no_contact(); }
+    if (!o.near || any(abs(o.d) > vec2<i32>(FRAC_ONE + FRAC_ONE / 2))) { return no_contact(); }
     var p = load_outline(poly, o.d, o.e);
     let ru = props[disk].radius_units;
     let rr = props[disk].radius_rem;

@@ -1,6 +1,19 @@
 // Stage: Gear predictor (src/integrate/gear.rs `predict`): a Taylor step of the six
 // scaled derivatives, q_k += sum_{l>k} C(l, k) q_l; q1 in fixed point (position.wgsl).
 
+// The binomials C(l, k) of q_l in q_k's update, GEAR_P<k><l> (src/integrate/gear.rs
+// `PREDICTOR`); C(l, 0) = 1.
+const GEAR_P12: f32 = 2.0;
+const GEAR_P13: f32 = 3.0;
+const GEAR_P14: f32 = 4.0;
+const GEAR_P15: f32 = 5.0;
+const GEAR_P23: f32 = 3.0;
+const GEAR_P24: f32 = 6.0;
+const GEAR_P25: f32 = 10.0;
+const GEAR_P34: f32 = 4.0;
+const GEAR_P35: f32 = 10.0;
+const GEAR_P45: f32 = 5.0;
+
 fn predict_one(s: ptr<function, State>) {
     let q1 = (*s).q[1];
     let q2 = (*s).q[2];
@@ -12,11 +25,11 @@ fn predict_one(s: ptr<function, State>) {
     move_by_whole_q1(s);
     turn_by(s, step.z);
     displace(s, step.xy);
-    (*s).q[1] += 2.0 * q2 + 3.0 * q3 + 4.0 * q4 + 5.0 * q5;
+    (*s).q[1] += GEAR_P12 * q2 + GEAR_P13 * q3 + GEAR_P14 * q4 + GEAR_P15 * q5;
     renormalize_q1(s);
-    (*s).q[2] += 3.0 * q3 + 6.0 * q4 + 10.0 * q5;
-    (*s).q[3] += 4.0 * q4 + 10.0 * q5;
-    (*s).q[4] += 5.0 * q5;
+    (*s).q[2] += GEAR_P23 * q3 + GEAR_P24 * q4 + GEAR_P25 * q5;
+    (*s).q[3] += GEAR_P34 * q4 + GEAR_P35 * q5;
+    (*s).q[4] += GEAR_P45 * q5;
 }
 
 // Particle i predicted, then surveyed (`bit`: see `survey_one`). `correct` with AHEAD

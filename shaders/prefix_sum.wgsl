@@ -6,7 +6,7 @@
 // the neighbour lists (issue 13).
 
 const SCAN_WG: u32 = 256u;
-var<workgroup> tile: array<u32, 256>;
+var<workgroup> tile: array<u32, SCAN_WG>;
 var<workgroup> lists: u32;
 
 // Whether the lists are rebuilt this step, as a value uniform over the workgroup (the

@@ -191,10 +191,10 @@ fn vertex_wall(l: WallLine, w: u32, i: u32, corner: vec2<i32>, ce: vec2<f32>, r_
 // The sub-contacts found so far (at most MAX_SUB with the cores above).
 struct Subs {
     count: u32,
-    key: array<u32, 4>,
-    delta: array<f32, 4>,
-    n: array<vec2<f32>, 4>,      // from j to i
-    point: array<vec2<f32>, 4>,  // the middle of the overlap (units, frame at i)
+    key: array<u32, MAX_SUB>,
+    delta: array<f32, MAX_SUB>,
+    n: array<vec2<f32>, MAX_SUB>,      // from j to i
+    point: array<vec2<f32>, MAX_SUB>,  // the middle of the overlap (units, frame at i)
 };
 
 // Adds a sub-contact; `flip`: the vertex is j's (its normal turned to point from j to

@@ -4,6 +4,9 @@
 
 use bytemuck::{Pod, Zeroable};
 
+use crate::spheropolygon::MAX_SUB;
+use crate::state::GEAR_VALUES;
+
 /// Candidates per particle as the lower id, and as the higher id, of disks and polygons
 /// (`Params::list_cap`; more for long rods, `gpu::list_capacity`).
 pub const MAX_CONTACTS: u32 = 16;
@@ -27,8 +30,12 @@ pub fn flags(active: bool, fixed: bool, material: u32, copy: u32) -> u32 {
 }
 /// Workgroup size of the per-particle kernels (`WG`).
 pub const WG: u32 = 64;
-/// Workgroup size of the prefix sum (`SCAN_WG`).
+/// Workgroup size of the prefix sum, and the elements one workgroup scans (`SCAN_WG`).
 pub const SCAN_WG: u32 = 256;
+
+/// 1.0 of a unit vector in Q30 integers (`Q30` in geometry.wgsl): a wall's normal
+/// (`Wall::nq`).
+pub const Q30: f64 = (1u64 << 30) as f64;
 
 /// `Params::law` (`LAW_*` in common.wgsl).
 pub const LAW_SPRING_DASHPOT: u32 = 0;
@@ -163,7 +170,7 @@ impl Default for Params {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct State {
-    pub q: [[f32; 4]; 6],
+    pub q: [[f32; 4]; GEAR_VALUES],
     pub anchor: [i32; 2],
     pub frac: [u32; 2],
     /// Orientation in whole turn units of 2π/2³² (see `orientation`); the remainder is
@@ -240,15 +247,15 @@ pub struct Entry {
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct SubSprings {
-    pub key: [u32; 4],
-    pub xi: [f32; 4],
+    pub key: [u32; MAX_SUB],
+    pub xi: [f32; MAX_SUB],
 }
 
 impl Default for SubSprings {
     fn default() -> Self {
         Self {
-            key: [EMPTY; 4],
-            xi: [0.0; 4],
+            key: [EMPTY; MAX_SUB],
+            xi: [0.0; MAX_SUB],
         }
     }
 }
@@ -403,14 +410,22 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
     ]
 }
 
+/// `hash_pair`'s multipliers of the ids and the offset of j (`PAIR_HASH_*` in
+/// common.wgsl); its finaliser is the buckets' (`HASH_MIX_1`, `HASH_MIX_2`).
+pub const PAIR_HASH_I: u32 = 0x9E37_79B1;
+pub const PAIR_HASH_J_ADD: u32 = 0x7F4A_7C15;
+pub const PAIR_HASH_J: u32 = 0x85EB_CA77;
+
 /// The spring table's slot hash, twin of `hash_pair` in common.wgsl (used on the host
 /// to rebuild a table from a checkpoint).
 pub fn hash_pair(i: u32, j: u32) -> u32 {
-    let mut h = i.wrapping_mul(0x9E37_79B1) ^ j.wrapping_add(0x7F4A_7C15).wrapping_mul(0x85EB_CA77);
+    use super::{HASH_MIX_1, HASH_MIX_2};
+    let mut h =
+        i.wrapping_mul(PAIR_HASH_I) ^ j.wrapping_add(PAIR_HASH_J_ADD).wrapping_mul(PAIR_HASH_J);
     h ^= h >> 16;
-    h = h.wrapping_mul(0x7FEB_352D);
+    h = h.wrapping_mul(HASH_MIX_1);
     h ^= h >> 15;
-    h = h.wrapping_mul(0x846C_A68B);
+    h = h.wrapping_mul(HASH_MIX_2);
     h ^= h >> 16;
     h
 }

@@ -26,6 +26,7 @@
 pub mod bindings;
 mod buckets;
 mod buffers;
+pub mod constants;
 pub mod footprint;
 pub use bindings::{BINDINGS, Binding};
 pub use footprint::{Footprint, footprint, max_particles};

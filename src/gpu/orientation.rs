@@ -9,8 +9,10 @@ use std::f64::consts::PI;
 
 /// One turn unit in radians, 2π / 2³².
 pub const TURN_UNIT: f64 = 2.0 * PI / 4_294_967_296.0;
-const Q31_ONE: u64 = 1 << 31;
-const TWO_PI_Q29: u64 = 3_373_259_426;
+/// 1.0 in Q31 (`Q31_ONE` in orientation.wgsl).
+pub const Q31_ONE: u64 = 1 << 31;
+/// round(2π · 2²⁹) (`TWO_PI_Q29` in orientation.wgsl).
+pub const TWO_PI_Q29: u64 = 3_373_259_426;
 
 /// Splits an angle (radians, any size) into whole turn units and a remainder.
 pub fn split_angle(theta: f64) -> (u32, f32) {

@@ -22,9 +22,8 @@ pub(super) fn wall_normal(w: &crate::geometry::WallSegment) -> ([i32; 2], f32, f
     let len = ab[0].hypot(ab[1]).max(f64::MIN_POSITIVE);
     let t = [ab[0] / len, ab[1] / len];
     let n = [-t[1], t[0]];
-    let q30 = (1u64 << 30) as f64;
-    let nq = [(n[0] * q30).round() as i32, (n[1] * q30).round() as i32];
-    let q = [nq[0] as f64 / q30, nq[1] as f64 / q30];
+    let nq = [(n[0] * Q30).round() as i32, (n[1] * Q30).round() as i32];
+    let q = [nq[0] as f64 / Q30, nq[1] as f64 / Q30];
     let beta = q[0] * t[0] + q[1] * t[1];
     let alpha = q[0] * n[0] + q[1] * n[1] - 1.0;
     (nq, beta as f32, alpha as f32)

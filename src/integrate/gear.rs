@@ -9,7 +9,9 @@
 
 use crate::state::{Dof, GEAR_VALUES, Particles};
 
-/// Corrector coefficients for second-order equations, velocity-dependent forces.
+/// Corrector coefficients for second-order equations, velocity-dependent forces
+/// (`GEAR_C<k>` in correct.wgsl, which adds Δ to q2 without a product: c2 = 1;
+/// tests/gpu_constants.rs).
 pub const CORRECTOR: [f64; GEAR_VALUES] = [
     3.0 / 20.0,
     251.0 / 360.0,
@@ -29,14 +31,45 @@ pub const CORRECTOR_POSITION_ONLY: [f64; GEAR_VALUES] = [
     1.0 / 60.0,
 ];
 
-/// Taylor predictor for one particle: q_k += Σ_{l>k} C(l, k) q_l.
+/// Predictor coefficients: `PREDICTOR[k][l]` = C(l, k), the binomial, for l > k (0
+/// elsewhere), Pascal's triangle. Row 0 is all ones, which `predict_one` (and
+/// predict.wgsl) add without a product; the other rows are `GEAR_P<k><l>` in
+/// predict.wgsl (tests/gpu_constants.rs).
+pub const PREDICTOR: [[f64; GEAR_VALUES]; GEAR_VALUES] = pascal();
+
+const fn pascal() -> [[f64; GEAR_VALUES]; GEAR_VALUES] {
+    // c[l][k] = C(l, k), row by row.
+    let mut c = [[0u32; GEAR_VALUES]; GEAR_VALUES];
+    let mut p = [[0.0; GEAR_VALUES]; GEAR_VALUES];
+    let mut l = 0;
+    while l < GEAR_VALUES {
+        c[l][0] = 1;
+        let mut k = 1;
+        while k <= l {
+            c[l][k] = c[l - 1][k - 1] + if k < l { c[l - 1][k] } else { 0 };
+            k += 1;
+        }
+        let mut k = 0;
+        while k < l {
+            p[k][l] = c[l][k] as f64;
+            k += 1;
+        }
+        l += 1;
+    }
+    p
+}
+
+/// Taylor predictor for one particle: q_k += Σ_{l>k} C(l, k) q_l (`PREDICTOR`).
+// `d` runs over the components of all six values, as in `correct_one`.
+#[allow(clippy::needless_range_loop)]
 pub fn predict_one(q: &mut [Dof; GEAR_VALUES]) {
+    const P: [[f64; GEAR_VALUES]; GEAR_VALUES] = PREDICTOR;
     for d in 0..3 {
         q[0][d] += q[1][d] + q[2][d] + q[3][d] + q[4][d] + q[5][d];
-        q[1][d] += 2.0 * q[2][d] + 3.0 * q[3][d] + 4.0 * q[4][d] + 5.0 * q[5][d];
-        q[2][d] += 3.0 * q[3][d] + 6.0 * q[4][d] + 10.0 * q[5][d];
-        q[3][d] += 4.0 * q[4][d] + 10.0 * q[5][d];
-        q[4][d] += 5.0 * q[5][d];
+        q[1][d] += P[1][2] * q[2][d] + P[1][3] * q[3][d] + P[1][4] * q[4][d] + P[1][5] * q[5][d];
+        q[2][d] += P[2][3] * q[3][d] + P[2][4] * q[4][d] + P[2][5] * q[5][d];
+        q[3][d] += P[3][4] * q[4][d] + P[3][5] * q[5][d];
+        q[4][d] += P[4][5] * q[5][d];
     }
 }
 
@@ -94,5 +127,23 @@ pub fn correct_in_place(v: [&mut Dof; GEAR_VALUES], accel: Dof, dt: f64) {
     correct_one(&mut q, accel, dt, &CORRECTOR);
     for (dst, src) in v.into_iter().zip(q) {
         *dst = src;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_predictor_is_pascals_triangle() {
+        let expected = [
+            [0.0, 1.0, 1.0, 1.0, 1.0, 1.0],
+            [0.0, 0.0, 2.0, 3.0, 4.0, 5.0],
+            [0.0, 0.0, 0.0, 3.0, 6.0, 10.0],
+            [0.0, 0.0, 0.0, 0.0, 4.0, 10.0],
+            [0.0, 0.0, 0.0, 0.0, 0.0, 5.0],
+            [0.0; GEAR_VALUES],
+        ];
+        assert_eq!(PREDICTOR, expected);
     }
 }
