@@ -571,12 +571,7 @@ fn a_run_with_output_vtk_writes_a_paraview_time_series() {
     // `talus render` writes from the snapshot files.
     let last = files[files.len() - 2].trim_end_matches("_grains.vtp");
     let out = dir.join("rendered");
-    let o = std::process::Command::new(common::talus_bin())
-        .args(["render", "--width", "64", "--out", out.to_str().unwrap()])
-        .arg(dir.join("snapshots").join(format!("{last}.json")))
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    render(&dir.join("snapshots").join(format!("{last}.json")), &out);
     for part in ["grains", "contacts"] {
         let run = std::fs::read(dir.join(format!("snapshots/{last}_{part}.vtp"))).unwrap();
         let rendered = std::fs::read(out.join(format!("{part}.vtp"))).unwrap();
@@ -1136,13 +1131,7 @@ fn vtk_draws_disks_as_points_and_polygons_as_their_outlines() {
     let dir = tmp("vtk-mixed");
     let json_path = talus::snapshot::write(&s, &dir, "snap").unwrap();
     let out = dir.join("pictures");
-    let o = std::process::Command::new(common::talus_bin())
-        .args(["render", "--width", "64", "--out"])
-        .arg(&out)
-        .arg(&json_path)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    render(&json_path, &out);
     let snap = talus::snapshot::read(&json_path).unwrap();
     let vtp = common::vtp::read(&out.join("grains.vtp"));
     assert_eq!(
@@ -1191,6 +1180,17 @@ fn vtk_draws_disks_as_points_and_polygons_as_their_outlines() {
         );
         assert_eq!(radius[8 + c], 0.0);
     }
+}
+
+/// `talus render` of a snapshot into `out`, small pictures.
+fn render(snapshot: &Path, out: &Path) {
+    let o = std::process::Command::new(common::talus_bin())
+        .args(["render", "--width", "64", "--out"])
+        .arg(out)
+        .arg(snapshot)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
 }
 
 /// A LAMMPS-style dump (`dump custom`'s layout, `render::dump`), parsed as OVITO and
@@ -1252,13 +1252,7 @@ fn render_writes_a_lammps_style_dump_that_holds_the_snapshot_exactly() {
     let dir = tmp("dump");
     let json_path = talus::snapshot::write(&s, &dir, "snap").unwrap();
     let out = dir.join("pictures");
-    let o = std::process::Command::new(common::talus_bin())
-        .args(["render", "--width", "64", "--out"])
-        .arg(&out)
-        .arg(&json_path)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    render(&json_path, &out);
     let d = Dump::read(&out.join("grains.dump"));
     let snap = talus::snapshot::read(&json_path).unwrap();
     assert_eq!(d.step, 400);
@@ -1317,13 +1311,7 @@ fn a_run_with_output_dump_writes_one_dump_per_snapshot() {
     let last = dumps.last().unwrap();
     let stem = (last.file_name().unwrap().to_str().unwrap()).trim_end_matches("_grains.dump");
     let out = dir.join("rendered");
-    let o = std::process::Command::new(common::talus_bin())
-        .args(["render", "--width", "64", "--out"])
-        .arg(&out)
-        .arg(dir.join("snapshots").join(format!("{stem}.json")))
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    render(&dir.join("snapshots").join(format!("{stem}.json")), &out);
     let run = std::fs::read(last).unwrap();
     assert!(run == std::fs::read(out.join("grains.dump")).unwrap(), "{stem}");
     assert!(!Dump::read(last).rows.is_empty());

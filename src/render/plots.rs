@@ -49,6 +49,33 @@ impl<'a> Axis<'a> {
     }
 }
 
+/// The frame every plot shares: an 800 × 500 SVG on white with its title, margins and
+/// room for the axis labels, into which `draw` puts the chart; written atomically.
+fn framed(
+    path: &Path,
+    title: &str,
+    draw: impl FnOnce(ChartBuilder<'_, '_, SVGBackend<'_>>) -> Result<(), String>,
+) -> Result<(), RenderError> {
+    let e = |message: String| RenderError::Plot {
+        path: path.to_path_buf(),
+        message,
+    };
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, (800, 500)).into_drawing_area();
+        root.fill(&WHITE).map_err(|x| e(x.to_string()))?;
+        let mut chart = ChartBuilder::on(&root);
+        chart
+            .caption(title, ("sans-serif", 22))
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(70);
+        draw(chart).map_err(e)?;
+        root.present().map_err(|x| e(x.to_string()))?;
+    }
+    write_atomic(path, text.as_bytes()).map_err(RenderError::write(path))
+}
+
 /// One line plot; `series` share the axes.
 fn plot(path: &Path, title: &str, x: Axis, y: Axis, series: &[Series]) -> Result<(), RenderError> {
     plot_with_bands(path, title, x, y, series, &[])
@@ -86,21 +113,9 @@ fn plot_with_bands(
         y1 = y0 + 1.0;
     }
     let y1 = y1 + 0.05 * (y1 - y0);
-    let mut text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut text, (800, 500)).into_drawing_area();
-        let e = |e: &dyn std::fmt::Display| RenderError::Plot {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        };
-        root.fill(&WHITE).map_err(|x| e(&x))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|x| e(&x))?;
+    framed(path, title, |mut builder| {
+        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let mut chart = (builder.build_cartesian_2d(x0..x1, y0..y1)).map_err(|x| e(&x))?;
         chart
             .configure_mesh()
             .x_desc(x.label())
@@ -141,9 +156,8 @@ fn plot_with_bands(
                 .draw()
                 .map_err(|x| e(&x))?;
         }
-        root.present().map_err(|x| e(&x))?;
-    }
-    write_atomic(path, text.as_bytes()).map_err(RenderError::write(path))
+        Ok(())
+    })
 }
 
 /// One line plot on a logarithmic y axis: points with y ≤ 0 (an empty bin) are left
@@ -182,20 +196,9 @@ fn plot_log_y(
         (0.1, 1.0)
     };
     x0 = x0.min(0.0);
-    let mut text = String::new();
-    {
-        let root = SVGBackend::with_string(&mut text, (800, 500)).into_drawing_area();
-        let e = |e: &dyn std::fmt::Display| RenderError::Plot {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        };
-        root.fill(&WHITE).map_err(|x| e(&x))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 22))
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(70)
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+    framed(path, title, |mut builder| {
+        let e = |x: &dyn std::fmt::Display| x.to_string();
+        let mut chart = (builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale()))
             .map_err(|x| e(&x))?;
         chart
             .configure_mesh()
@@ -204,22 +207,17 @@ fn plot_log_y(
             .y_label_formatter(&|v| format!("{v:.0e}"))
             .draw()
             .map_err(|x| e(&x))?;
-        for (name, color, data) in series {
+        for (_, color, data) in series {
             let c = *color;
             let line = data.iter().filter(shown).copied();
             chart
                 .draw_series(LineSeries::new(line, c.stroke_width(2)))
-                .map_err(|x| e(&x))?
-                .label(*name)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2))
-                });
+                .map_err(|x| e(&x))?;
             let dots = data.iter().filter(shown).map(|&p| Circle::new(p, 3, c.filled()));
             chart.draw_series(dots).map_err(|x| e(&x))?;
         }
-        root.present().map_err(|x| e(&x))?;
-    }
-    write_atomic(path, text.as_bytes()).map_err(RenderError::write(path))
+        Ok(())
+    })
 }
 
 pub fn write_plots(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError> {
