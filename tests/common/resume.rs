@@ -5,53 +5,41 @@ use super::{Path, engine};
 use talus::checkpoint::{self, Checkpoint};
 use talus::gpu::{DeviceState, GpuSimulation};
 use talus::run::Engine;
-use talus::scene::Scene;
 use talus::sim::Simulation;
 
 /// Runs `scene` on `path` for `total` steps uninterrupted; runs it again to `split`,
 /// writes a checkpoint file through the real encoder, reads it back (it must hold
-/// exactly the state written), hands it to `check`, resumes it on the same path in a
-/// fresh engine (a fresh device context on the GPU) and runs on to `total`: the two end
-/// states must be bitwise the same (`assert_same_state`). Returns the uninterrupted
-/// run, for checks of its end state; None when the GPU path is skipped (no adapter,
-/// without TALUS_REQUIRE_GPU=1).
+/// exactly the state written), hands it to `check`, resumes it on the same path (on the
+/// GPU in a fresh device context) and runs on to `total`: the end states must be bitwise
+/// the same. Returns the uninterrupted run; None when the GPU path is skipped.
 pub fn assert_resumes_bitwise(
     path: Path,
     test: &str,
-    scene: &Scene,
+    scene: &talus::scene::Scene,
     total: u64,
     split: u64,
     check: impl Fn(&Checkpoint),
 ) -> Option<Engine> {
     let fresh = || engine(path, test, Simulation::new(scene.clone()).expect("builds"));
-    let mut straight = fresh()?;
+    let (mut straight, mut half) = (fresh()?, fresh()?);
     straight.advance(total).expect("the uninterrupted run runs");
-    let mut half = fresh().expect("a second engine");
     half.advance(split).expect("the run to the checkpoint runs");
-    let file =
-        std::env::temp_dir().join(format!("talus-{test}-{path:?}-{}.ckpt", std::process::id()));
+    let pid = std::process::id();
+    let file = std::env::temp_dir().join(format!("talus-{test}-{path:?}-{pid}.ckpt"));
     let (sim, device) = half.checkpoint_state().expect("the state reads back");
     checkpoint::write(sim, device, &file).expect("the checkpoint is written");
     let loaded = checkpoint::read(&file, &[]).expect("the checkpoint loads");
     std::fs::remove_file(&file).ok();
-    assert_eq!(
-        loaded.sim.step, split,
-        "{test} on {path:?}: checkpoint step"
-    );
-    let written = exact_state(&mut half);
     let read = match (path, &loaded.device) {
         (Path::Cpu, None) => sim_fields(&loaded.sim),
         (Path::Gpu, Some(d)) => device_fields(d),
         (_, d) => panic!(
-            "{test} on {path:?}: a checkpoint {} the device state",
-            if d.is_some() { "carries" } else { "lacks" }
+            "{test} on {path:?}: device state in the checkpoint: {}",
+            d.is_some()
         ),
     };
-    same(
-        &written,
-        &read,
-        &format!("{test} on {path:?}: the checkpoint read back"),
-    );
+    let what = format!("{test} on {path:?}: the checkpoint at step {split} read back");
+    same(&exact_state(&mut half), &read, &what);
     check(&loaded);
     let mut resumed = match path {
         Path::Cpu => Engine::cpu(loaded.sim),
@@ -65,27 +53,22 @@ pub fn assert_resumes_bitwise(
     resumed
         .advance(total - split)
         .expect("the resumed run runs");
-    assert_same_state(
-        &mut straight,
-        &mut resumed,
-        &format!(
-            "{test} on {path:?}: resumed at step {split} against uninterrupted, at step {total}"
-        ),
-    );
+    let what = format!("{test} on {path:?}: resumed at step {split} against uninterrupted");
+    assert_same_state(&mut straight, &mut resumed, &what);
     Some(straight)
 }
 
-/// Two engines' exact states are the same bit for bit: on the CPU the f64 state (Gear
-/// values, particle properties, sources, generator) and the springs; on the GPU the
-/// device state. A failure names the first field and index that differ.
+/// Two engines' exact states are the same bit for bit: on the CPU the f64 state and the
+/// springs, on the GPU the device state. A failure names the first field and index that
+/// differ.
 pub fn assert_same_state(a: &mut Engine, b: &mut Engine, what: &str) {
     same(&exact_state(a), &exact_state(b), what);
 }
 
-type Fields = Vec<(String, Vec<String>)>;
+/// A state field by field, each element as its Debug text (which tells every f64 and
+/// f32 apart, -0 from 0 included).
+type Fields = Vec<(&'static str, Vec<String>)>;
 
-/// An engine's exact state, field by field, each element as its Debug text (which tells
-/// every f64 and f32 apart, -0 from 0 included).
 fn exact_state(e: &mut Engine) -> Fields {
     match e {
         Engine::Cpu(s) => sim_fields(s),
@@ -93,57 +76,65 @@ fn exact_state(e: &mut Engine) -> Fields {
     }
 }
 
-fn column<T: std::fmt::Debug>(name: &str, v: impl IntoIterator<Item = T>) -> (String, Vec<String>) {
-    (
-        name.to_string(),
-        v.into_iter().map(|x| format!("{x:?}")).collect(),
-    )
+fn col<T: std::fmt::Debug>(
+    name: &'static str,
+    v: impl IntoIterator<Item = T>,
+) -> (&'static str, Vec<String>) {
+    (name, v.into_iter().map(|x| format!("{x:?}")).collect())
 }
 
 fn sim_fields(s: &Simulation) -> Fields {
-    let p = &s.particles;
-    let springs = s.spring_table();
+    let (p, springs) = (&s.particles, s.spring_table());
     let mut table: Vec<_> = springs.entries().collect();
     table.sort_by_key(|e| e.0);
-    let mut f = vec![
-        column("step", [s.step]),
-        column("lost", [s.lost]),
-        column("rng", [&s.rng]),
-        column("sources", &s.sources),
-    ];
-    f.extend((0..p.q.len()).map(|k| column(&format!("Gear value q{k}"), &p.q[k])));
+    let gear = ["q0", "q1", "q2", "q3", "q4", "q5"].into_iter().zip(&p.q);
+    let mut f: Fields = gear.map(|(name, q)| col(name, q)).collect();
     f.extend([
-        column("radius", &p.radius),
-        column("mass", &p.mass),
-        column("inertia", &p.inertia),
-        column("fixed", &p.fixed),
-        column("active", &p.active),
-        column("material", &p.material),
-        column("shape", &p.shape),
-        column("sweep", &p.sweep),
-        column("copy", &p.copy),
-        column("springs", table),
-        column("sub-contact springs", &springs.sub),
+        col("step, lost", [s.step, s.lost]),
+        col("rng", [&s.rng]),
+        col("sources", &s.sources),
+    ]);
+    f.extend([
+        col("radius", &p.radius),
+        col("mass", &p.mass),
+        col("inertia", &p.inertia),
+    ]);
+    f.extend([
+        col("fixed", &p.fixed),
+        col("active", &p.active),
+        col("material", &p.material),
+    ]);
+    f.extend([
+        col("shape", &p.shape),
+        col("sweep", &p.sweep),
+        col("copy", &p.copy),
+    ]);
+    f.extend([
+        col("springs", table),
+        col("sub-contact springs", &springs.sub),
     ]);
     f
 }
 
 fn device_fields(d: &DeviceState) -> Fields {
+    let (states, props) = (
+        col("device states", &d.states),
+        col("device props", &d.props),
+    );
     vec![
-        column("device states", &d.states),
-        column("device props", &d.props),
-        column("device springs", &d.springs),
-        column("device sub-contact springs", &d.sub),
+        states,
+        props,
+        col("device springs", &d.springs),
+        col("device sub", &d.sub),
     ]
 }
 
 fn same(a: &Fields, b: &Fields, what: &str) {
     for ((name, x), (_, y)) in a.iter().zip(b) {
         if let Some(i) = (0..x.len().max(y.len())).find(|&i| x.get(i) != y.get(i)) {
+            let (n, m) = (x.len(), y.len());
             panic!(
-                "{what}: {name} differs first at index {i} (lengths {} and {}):\n  {:?}\n  {:?}",
-                x.len(),
-                y.len(),
+                "{what}: {name} differs first at [{i}] (of {n} and {m}):\n  {:?}\n  {:?}",
                 x.get(i),
                 y.get(i)
             );
