@@ -108,10 +108,10 @@ fn resume_from_checkpoint_is_bitwise_identical() {
             continue;
         };
         let s = e.sim().unwrap();
-        let (n, contacts) = (s.particles.active_count(), s.contacts.len());
+        let (n, c) = (s.particles.active_count(), s.contacts.len());
         assert!(
-            n > 150 && contacts > 150,
-            "a non-trivial state: {n}, {contacts}"
+            n > 150 && c > 150,
+            "a non-trivial state: {n} particles, {c} contacts"
         );
     }
 }

@@ -349,11 +349,8 @@ fn gpu_rod_runs_resume_bitwise() {
     // The sub-contact springs go through the checkpoint's device section. (GPU only: on
     // the CPU path the checkpoint drops a pending rod's velocity kick, and the resumed
     // run differs: src/checkpoint.rs decodes it as [0, 0].)
-    let (test, scene, check) = (
-        "gpu_rod_runs_resume_bitwise",
-        rod_deposition(),
-        common::carries_sub_springs,
-    );
+    let (test, scene) = ("gpu_rod_runs_resume_bitwise", rod_deposition());
+    let check = common::carries_sub_springs;
     let Some(e) =
         common::assert_resumes_bitwise(common::Path::Gpu, test, &scene, 15000, 7500, check)
     else {

@@ -351,11 +351,8 @@ fn assert_bitwise(test: &str, scene: fn() -> talus::scene::Scene, steps: u64) {
         else {
             continue;
         };
-        assert!(
-            a.active_count() > 30,
-            "particles were poured: {}",
-            a.active_count()
-        );
+        let n = a.active_count();
+        assert!(n > 30, "particles were poured: {n}");
         let mut c = common::engine(path, test, Simulation::new(scene()).unwrap()).unwrap();
         c.advance(steps).unwrap();
         common::assert_same_state(&mut a, &mut c, &format!("{test} on {path:?}: two runs"));

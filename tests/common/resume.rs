@@ -69,6 +69,12 @@ pub fn assert_same_state(a: &mut Engine, b: &mut Engine, what: &str) {
 /// f32 apart, -0 from 0 included).
 type Fields = Vec<(&'static str, Vec<String>)>;
 
+macro_rules! fields {
+    ($($name:literal: $v:expr),* $(,)?) => {
+        vec![$(($name, $v.into_iter().map(|x| format!("{x:?}")).collect())),*]
+    };
+}
+
 fn exact_state(e: &mut Engine) -> Fields {
     match e {
         Engine::Cpu(s) => sim_fields(s),
@@ -76,68 +82,28 @@ fn exact_state(e: &mut Engine) -> Fields {
     }
 }
 
-fn col<T: std::fmt::Debug>(
-    name: &'static str,
-    v: impl IntoIterator<Item = T>,
-) -> (&'static str, Vec<String>) {
-    (name, v.into_iter().map(|x| format!("{x:?}")).collect())
-}
-
 fn sim_fields(s: &Simulation) -> Fields {
     let (p, springs) = (&s.particles, s.spring_table());
     let mut table: Vec<_> = springs.entries().collect();
     table.sort_by_key(|e| e.0);
-    let gear = ["q0", "q1", "q2", "q3", "q4", "q5"].into_iter().zip(&p.q);
-    let mut f: Fields = gear.map(|(name, q)| col(name, q)).collect();
-    f.extend([
-        col("step, lost", [s.step, s.lost]),
-        col("rng", [&s.rng]),
-        col("sources", &s.sources),
-    ]);
-    f.extend([
-        col("radius", &p.radius),
-        col("mass", &p.mass),
-        col("inertia", &p.inertia),
-    ]);
-    f.extend([
-        col("fixed", &p.fixed),
-        col("active", &p.active),
-        col("material", &p.material),
-    ]);
-    f.extend([
-        col("shape", &p.shape),
-        col("sweep", &p.sweep),
-        col("copy", &p.copy),
-    ]);
-    f.extend([
-        col("springs", table),
-        col("sub-contact springs", &springs.sub),
-    ]);
-    f
+    let [q0, q1, q2, q3, q4, q5] = &p.q;
+    fields!("step, lost": [s.step, s.lost], "rng": [&s.rng], "sources": &s.sources,
+        "Gear q0": q0, "Gear q1": q1, "Gear q2": q2, "Gear q3": q3, "Gear q4": q4, "Gear q5": q5,
+        "radius": &p.radius, "mass": &p.mass, "inertia": &p.inertia, "fixed": &p.fixed,
+        "active": &p.active, "material": &p.material, "shape": &p.shape, "sweep": &p.sweep,
+        "copy": &p.copy, "springs": table, "sub-contact springs": &springs.sub)
 }
 
 fn device_fields(d: &DeviceState) -> Fields {
-    let (states, props) = (
-        col("device states", &d.states),
-        col("device props", &d.props),
-    );
-    vec![
-        states,
-        props,
-        col("device springs", &d.springs),
-        col("device sub", &d.sub),
-    ]
+    fields!("device states": &d.states, "device props": &d.props,
+        "device springs": &d.springs, "device sub-contact springs": &d.sub)
 }
 
 fn same(a: &Fields, b: &Fields, what: &str) {
     for ((name, x), (_, y)) in a.iter().zip(b) {
         if let Some(i) = (0..x.len().max(y.len())).find(|&i| x.get(i) != y.get(i)) {
-            let (n, m) = (x.len(), y.len());
-            panic!(
-                "{what}: {name} differs first at [{i}] (of {n} and {m}):\n  {:?}\n  {:?}",
-                x.get(i),
-                y.get(i)
-            );
+            let (n, m, u, v) = (x.len(), y.len(), x.get(i), y.get(i));
+            panic!("{what}: {name} differs first at [{i}] (of {n} and {m}):\n  {u:?}\n  {v:?}");
         }
     }
 }
