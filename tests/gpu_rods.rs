@@ -346,37 +346,15 @@ fn a_rod_deposition_agrees_with_the_cpu() {
 
 #[test]
 fn gpu_rod_runs_resume_bitwise() {
-    // The sub-contact springs go through the checkpoint's device section.
-    let test = "gpu_rod_runs_resume_bitwise";
-    let Some(gpu) = common::gpu(test) else { return };
-    let steps = 15000;
-    let mut a = GpuSimulation::with_gpu(Simulation::new(rod_deposition()).unwrap(), gpu).unwrap();
-    a.advance(steps).unwrap();
-    let gpu = common::gpu(test).unwrap();
-    let mut b = GpuSimulation::with_gpu(Simulation::new(rod_deposition()).unwrap(), gpu).unwrap();
-    b.advance(steps / 2).unwrap();
-    let (sim, device) = b.checkpoint_state();
-    let bytes = talus::checkpoint::encode(sim, device);
-    let dir = std::env::temp_dir().join(format!("talus-gpu-rods-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("ckpt.bin");
-    std::fs::write(&path, bytes).unwrap();
-    let loaded = talus::checkpoint::read(&path, &[]).unwrap();
-    let ds = loaded
-        .device
-        .as_ref()
-        .expect("a GPU checkpoint carries the device state");
-    assert!(
-        ds.sub.iter().any(|s| s.key[0] != u32::MAX),
-        "the checkpoint holds sub-contact springs"
-    );
-    let mut c = GpuSimulation::resume_with_gpu(loaded, common::gpu(test).unwrap()).unwrap();
-    c.advance(steps - steps / 2).unwrap();
-    let (sa, sc) = (a.device_state(), c.device_state());
-    assert!(sa.states.len() == 16, "{} rods", sa.states.len());
-    assert!(
-        sa == sc,
-        "the resumed GPU run differs from the uninterrupted one"
-    );
-    std::fs::remove_dir_all(&dir).ok();
+    // The sub-contact springs go through the checkpoint's device section. (GPU only: on
+    // the CPU path the checkpoint drops a pending rod's velocity kick, and the resumed
+    // run differs: src/checkpoint.rs decodes it as [0, 0].)
+    let (test, scene) = ("gpu_rod_runs_resume_bitwise", rod_deposition());
+    let check = common::carries_sub_springs;
+    let Some(e) =
+        common::assert_resumes_bitwise(common::Path::Gpu, test, &scene, 15000, 7500, check)
+    else {
+        return;
+    };
+    assert_eq!(e.active_count(), 16, "every rod was poured");
 }

@@ -341,43 +341,22 @@ fn assert_columns(name: &str, domain: Option<serde_json::Value>) {
     }
 }
 
-/// Two GPU runs of a scene are bitwise equal, and so is one resumed through a checkpoint
-/// file in a fresh device context.
-fn assert_gpu_bitwise(name: &str, scene: fn() -> talus::scene::Scene, steps: u64) {
-    let Some(mut a) = gpu_sim(name, scene()) else {
-        return;
-    };
-    let mut b = gpu_sim(name, scene()).unwrap();
-    a.advance(steps).unwrap();
-    b.advance(steps / 2).unwrap();
-    // b: through a checkpoint file, then on in a fresh device context.
-    let dir = std::env::temp_dir().join(format!("talus-gpu-resume-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("ckpt.bin");
-    let (sim, device) = b.checkpoint_state();
-    talus::checkpoint::write(sim, device, &path).unwrap();
-    let loaded = talus::checkpoint::read(&path, &[]).unwrap();
-    assert!(
-        loaded.device.is_some(),
-        "a GPU checkpoint carries the device state"
-    );
-    let gpu = common::gpu("resume").unwrap();
-    let mut b = GpuSimulation::resume_with_gpu(loaded, gpu).unwrap();
-    b.advance(steps - steps / 2).unwrap();
-    let (sa, sb) = (a.device_state(), b.device_state());
-    assert!(
-        sa.states.len() > 30,
-        "particles were poured: {}",
-        sa.states.len()
-    );
-    assert!(
-        sa == sb,
-        "resumed GPU run differs from the uninterrupted one"
-    );
-    // And a third, uninterrupted run is the same bit for bit.
-    let mut c = gpu_sim(name, scene()).unwrap();
-    c.advance(steps).unwrap();
-    assert!(c.device_state() == sa, "two GPU runs of one scene differ");
+/// On each path, a run resumed through a checkpoint file (on the GPU in a fresh device
+/// context) is bitwise the uninterrupted one, and so is a third, uninterrupted run.
+fn assert_bitwise(test: &str, scene: fn() -> talus::scene::Scene, steps: u64) {
+    for path in common::PATHS {
+        let no_check = |_: &_| {};
+        let Some(mut a) =
+            common::assert_resumes_bitwise(path, test, &scene(), steps, steps / 2, no_check)
+        else {
+            continue;
+        };
+        let n = a.active_count();
+        assert!(n > 30, "particles were poured: {n}");
+        let mut c = common::engine(path, test, Simulation::new(scene()).unwrap()).unwrap();
+        c.advance(steps).unwrap();
+        common::assert_same_state(&mut a, &mut c, &format!("{test} on {path:?}: two runs"));
+    }
 }
 
 #[test]
@@ -498,13 +477,13 @@ fn a_gpu_halt_names_its_step_while_later_batches_are_in_flight() {
 
 #[test]
 fn gpu_runs_are_bitwise_reproducible_and_resume_bitwise() {
-    assert_gpu_bitwise("gpu_runs_are_bitwise_reproducible", quick_pour, 6000);
+    assert_bitwise("gpu_runs_are_bitwise_reproducible", quick_pour, 6000);
 }
 
 #[test]
 fn gpu_polygon_runs_are_bitwise_reproducible_and_resume_bitwise() {
     // Polygons: the corner buffer is laid out afresh on resume.
-    assert_gpu_bitwise("gpu_polygon_runs_are_bitwise", polygon_pour, 4500);
+    assert_bitwise("gpu_polygon_runs_are_bitwise", polygon_pour, 4500);
 }
 
 #[test]
@@ -796,7 +775,7 @@ fn layered_polygons() -> talus::scene::Scene {
 fn gpu_layered_runs_resume_bitwise() {
     // Rows measured on the pile at steps 0, 750 and 1500; the checkpoint at step 1000
     // lies between two.
-    assert_gpu_bitwise("gpu_layered_runs_resume_bitwise", layered_polygons, 2000);
+    assert_bitwise("gpu_layered_runs_resume_bitwise", layered_polygons, 2000);
 }
 
 #[test]

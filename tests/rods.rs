@@ -298,21 +298,11 @@ fn a_rod_pile_is_bitwise_the_same_on_any_thread_count_and_skin() {
 fn a_rod_pile_resumes_bitwise_from_a_checkpoint() {
     // The sweeps and every pair's sub-contact springs travel in the checkpoint: a run
     // resumed halfway ends bitwise where the straight run does.
-    let v = pile(None);
-    let straight = run_on(1, &v, 12_000);
-    let half = run_on(1, &v, 6_000);
-    let springs = half.spring_table();
-    assert!(
-        !springs.sub.is_empty(),
-        "the checkpoint carries sub-contact springs"
-    );
-    let path = std::env::temp_dir().join(format!("talus-rods-{}.ckpt", std::process::id()));
-    talus::checkpoint::write(&half, None, &path).unwrap();
-    let mut resumed = talus::checkpoint::read(&path, &[]).unwrap().sim;
-    let _ = std::fs::remove_file(&path);
-    assert_eq!(resumed.particles.sweep, half.particles.sweep);
-    resumed.advance(6_000).unwrap();
-    same_state(&straight, &resumed, "resumed");
+    for path in common::PATHS {
+        let test = "a_rod_pile_resumes_bitwise_from_a_checkpoint";
+        let scene = common::parse(&pile(None));
+        common::assert_resumes_bitwise(path, test, &scene, 12_000, 6_000, carries_sub_springs);
+    }
 }
 
 #[test]

@@ -7,8 +7,12 @@ use talus::sim::Simulation;
 
 pub mod mutate;
 pub mod pairs;
+pub mod resume;
 pub mod vtp;
 pub mod wgsl;
+
+#[allow(unused_imports)] // each test binary uses some
+pub use resume::{assert_resumes_bitwise, assert_same_state, carries_sub_springs};
 
 /// The talus binary that tests start: `TALUS_BIN` when set (`scripts/gpu-check` runs
 /// test binaries staged without cargo's target folder, beside a staged talus), else the
