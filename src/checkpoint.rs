@@ -52,11 +52,19 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
     e.u64(sim.sources.len() as u64);
     for s in &sim.sources {
         e.u32(s.inserted);
+        // A drawn candidate: 1, its five values; 2 (a rod's, which falls with a kick
+        // of velocity), the five and the kick. Without a kick the bytes are those of
+        // checkpoints before the kick was kept.
         match s.pending {
             Some(c) => {
-                e.u8(1);
+                let kicked = c.kick != [0.0; 2];
+                e.u8(if kicked { 2 } else { 1 });
                 for v in [c.x, c.axes[0], c.axes[1], c.start, c.theta] {
                     e.f64(v);
+                }
+                if kicked {
+                    e.f64(c.kick[0]);
+                    e.f64(c.kick[1]);
                 }
             }
             None => e.u8(0),
@@ -311,9 +319,10 @@ fn decode(
     let mut sources = Vec::new();
     for _ in 0..n_sources {
         let inserted = d.u32().map_err(corrupt)?;
-        let pending = if d.u8().map_err(corrupt)? == 1 {
-            let mut v = [0.0; 5];
-            for x in &mut v {
+        let flag = d.u8().map_err(corrupt)?;
+        let pending = if flag == 1 || flag == 2 {
+            let mut v = [0.0; 7];
+            for x in &mut v[..if flag == 2 { 7 } else { 5 }] {
                 *x = d.f64().map_err(corrupt)?;
             }
             Some(crate::create::source::Drawn {
@@ -321,8 +330,7 @@ fn decode(
                 axes: [v[1], v[2]],
                 start: v[3],
                 theta: v[4],
-                // Only rods have one, and rod runs write no checkpoints yet.
-                kick: [0.0; 2],
+                kick: [v[5], v[6]],
             })
         } else {
             None

@@ -346,15 +346,15 @@ fn a_rod_deposition_agrees_with_the_cpu() {
 
 #[test]
 fn gpu_rod_runs_resume_bitwise() {
-    // The sub-contact springs go through the checkpoint's device section. (GPU only: on
-    // the CPU path the checkpoint drops a pending rod's velocity kick, and the resumed
-    // run differs: src/checkpoint.rs decodes it as [0, 0].)
+    // The sub-contact springs go through the checkpoint's device section (GPU) or its
+    // spring table (CPU), and a pending rod's velocity kick through its source's state.
     let (test, scene) = ("gpu_rod_runs_resume_bitwise", rod_deposition());
     let check = common::carries_sub_springs;
-    let Some(e) =
-        common::assert_resumes_bitwise(common::Path::Gpu, test, &scene, 15000, 7500, check)
-    else {
-        return;
-    };
-    assert_eq!(e.active_count(), 16, "every rod was poured");
+    for path in common::PATHS {
+        let Some(e) = common::assert_resumes_bitwise(path, test, &scene, 15000, 7500, check)
+        else {
+            continue;
+        };
+        assert_eq!(e.active_count(), 16, "{path:?}: every rod was poured");
+    }
 }
