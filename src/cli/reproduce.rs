@@ -254,8 +254,10 @@ pub(super) fn finish_reproduction(
         serde_json::to_string_pretty(report).unwrap().as_bytes(),
     )
     .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
+    // The paper's claim, said as the paper's: whether this run bears it out is in the
+    // measurements above and in reproduce.json, not in this line.
     out!(
-        "{id}: {}; results in {}",
+        "{id}: the paper reports {}; compare the measurements above; results in {}",
         talus::reproduce::claim(id),
         root.display()
     );
