@@ -1257,7 +1257,9 @@ fn render_writes_a_lammps_style_dump_that_holds_the_snapshot_exactly() {
     let snap = talus::snapshot::read(&json_path).unwrap();
     assert_eq!(d.step, 400);
     assert_eq!(d.time, snap.meta.time);
-    for c in ["id", "type", "x", "y", "z", "vx", "vy", "radius", "mass", "omegaz", "fx"] {
+    for c in [
+        "id", "type", "x", "y", "z", "vx", "vy", "radius", "mass", "omegaz", "fx",
+    ] {
         assert!(d.columns.iter().any(|x| x == c), "OVITO's column {c}");
     }
     let ids = d.column("id");
@@ -1296,8 +1298,18 @@ fn a_run_with_output_dump_writes_one_dump_per_snapshot() {
     let o = std::process::Command::new(common::talus_bin())
         .args(["run", "-q", "--backend", "cpu", "--out"])
         .arg(&dir)
-        .args(["--set", "output.dump=true", "--set", "output.snapshot_every=1"])
-        .args(["--set", "stop.time=3", "--set", "stop.kinetic_fraction=null"])
+        .args([
+            "--set",
+            "output.dump=true",
+            "--set",
+            "output.snapshot_every=1",
+        ])
+        .args([
+            "--set",
+            "stop.time=3",
+            "--set",
+            "stop.kinetic_fraction=null",
+        ])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -1307,12 +1319,18 @@ fn a_run_with_output_dump_writes_one_dump_per_snapshot() {
         .collect();
     dumps.sort();
     assert!(dumps.len() >= 3, "{dumps:?}");
-    assert!(!dir.join("snapshots/snapshots.pvd").exists(), "no VTK asked for");
+    assert!(
+        !dir.join("snapshots/snapshots.pvd").exists(),
+        "no VTK asked for"
+    );
     let last = dumps.last().unwrap();
     let stem = (last.file_name().unwrap().to_str().unwrap()).trim_end_matches("_grains.dump");
     let out = dir.join("rendered");
     render(&dir.join("snapshots").join(format!("{stem}.json")), &out);
     let run = std::fs::read(last).unwrap();
-    assert!(run == std::fs::read(out.join("grains.dump")).unwrap(), "{stem}");
+    assert!(
+        run == std::fs::read(out.join("grains.dump")).unwrap(),
+        "{stem}"
+    );
     assert!(!Dump::read(last).rows.is_empty());
 }

@@ -104,7 +104,10 @@ fn module_of(src: &Path, file: &Path) -> Vec<String> {
         .components()
         .map(|c| c.as_os_str().to_string_lossy().into_owned())
         .collect();
-    if matches!(parts.last().map(String::as_str), Some("mod" | "lib" | "main")) {
+    if matches!(
+        parts.last().map(String::as_str),
+        Some("mod" | "lib" | "main")
+    ) {
         parts.pop();
     }
     parts
@@ -340,7 +343,10 @@ fn graphs() -> (Graph, BTreeMap<String, Graph>) {
                     edges: BTreeMap::new(),
                 });
                 let name = |m: &[String]| format!("{}::{}", m[0], m[1]);
-                g.edges.entry(name(&from)).or_default().insert(name(&target));
+                g.edges
+                    .entry(name(&from))
+                    .or_default()
+                    .insert(name(&target));
             }
         }
     }
@@ -350,7 +356,11 @@ fn graphs() -> (Graph, BTreeMap<String, Graph>) {
 #[test]
 fn the_module_graph_has_no_new_cycles() {
     let (top, inner) = graphs();
-    assert!(top.edges.len() > 10, "the graph was read: {:?}", top.edges.keys());
+    assert!(
+        top.edges.len() > 10,
+        "the graph was read: {:?}",
+        top.edges.keys()
+    );
     let mut found: Vec<Vec<String>> = cycles(&top);
     for g in inner.values() {
         found.extend(cycles(g));
@@ -382,14 +392,29 @@ fn the_cycle_finder_finds_a_cycle_and_only_one() {
     // Paths as a file writes them.
     let text = "use crate::{a::B, c::{d, e::F}};\nuse super::x;\n// crate::comment\nfn f() { crate::g::h(); }\n#[cfg(test)]\nmod tests {\n use crate::t;\n}\n";
     let p = paths(&code(text));
-    for want in ["crate::a::B", "crate::c::d", "crate::c::e::F", "super::x", "crate::g::h"] {
+    for want in [
+        "crate::a::B",
+        "crate::c::d",
+        "crate::c::e::F",
+        "super::x",
+        "crate::g::h",
+    ] {
         assert!(p.iter().any(|x| x == want), "{want} in {p:?}");
     }
-    assert!(!p.iter().any(|x| x.contains("comment") || x == "crate::t"), "{p:?}");
+    assert!(
+        !p.iter().any(|x| x.contains("comment") || x == "crate::t"),
+        "{p:?}"
+    );
     let from = ["a".to_string(), "b".to_string()];
-    assert_eq!(resolve("super::x", &from), Some(vec!["a".into(), "x".into()]));
+    assert_eq!(
+        resolve("super::x", &from),
+        Some(vec!["a".into(), "x".into()])
+    );
     assert_eq!(resolve("super::x", &from[..1]), Some(vec!["x".into()]));
-    assert_eq!(resolve("self::y", &from[..1]), Some(vec!["a".into(), "y".into()]));
+    assert_eq!(
+        resolve("self::y", &from[..1]),
+        Some(vec!["a".into(), "y".into()])
+    );
 }
 
 #[test]
@@ -400,7 +425,11 @@ fn no_file_grows_past_the_size_limit() {
     let mut over = Vec::new();
     for f in &files {
         let lines = std::fs::read_to_string(f).unwrap().lines().count();
-        let name = f.strip_prefix(&src).unwrap().to_string_lossy().replace('\\', "/");
+        let name = f
+            .strip_prefix(&src)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
         let limit = (OVERSIZED.iter().find(|o| o.0 == name)).map_or(MAX_LINES, |o| o.1);
         if lines > limit {
             over.push(format!("src/{name}: {lines} lines (at most {limit})"));
@@ -425,8 +454,14 @@ fn no_new_file_at_the_top_of_src() {
         .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
     top.sort();
-    let new: Vec<_> = top.iter().filter(|f| !TOP_LEVEL.contains(&f.as_str())).collect();
-    let gone: Vec<_> = TOP_LEVEL.iter().filter(|f| !top.iter().any(|t| t == *f)).collect();
+    let new: Vec<_> = top
+        .iter()
+        .filter(|f| !TOP_LEVEL.contains(&f.as_str()))
+        .collect();
+    let gone: Vec<_> = TOP_LEVEL
+        .iter()
+        .filter(|f| !top.iter().any(|t| t == *f))
+        .collect();
     assert!(
         new.is_empty() && gone.is_empty(),
         "new files at the top of src/ (put them in a layer): {new:?}\nlisted but gone: {gone:?}"

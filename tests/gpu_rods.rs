@@ -351,8 +351,7 @@ fn gpu_rod_runs_resume_bitwise() {
     let (test, scene) = ("gpu_rod_runs_resume_bitwise", rod_deposition());
     let check = common::carries_sub_springs;
     for path in common::PATHS {
-        let Some(e) = common::assert_resumes_bitwise(path, test, &scene, 15000, 7500, check)
-        else {
+        let Some(e) = common::assert_resumes_bitwise(path, test, &scene, 15000, 7500, check) else {
             continue;
         };
         assert_eq!(e.active_count(), 16, "{path:?}: every rod was poured");

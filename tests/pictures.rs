@@ -151,7 +151,11 @@ fn rgb(png: &Pixmap, x: u32, y: u32) -> [u8; 3] {
 /// (antialiased small glyphs rarely cover a whole pixel).
 fn assert_spelled(png: &Pixmap, t: &Text, colour: [u8; 3]) {
     let k = (t.size / text::font_size(1) as f64).round() as u32;
-    assert!((t.size - text::font_size(k) as f64).abs() < 0.06, "size {}", t.size);
+    assert!(
+        (t.size - text::font_size(k) as f64).abs() < 0.06,
+        "size {}",
+        t.size
+    );
     let w = text::width(&t.words, k) as i64;
     let left = if t.end { t.x as i64 - w } else { t.x as i64 };
     let top = t.y as i64 - text::baseline(k) as i64;
@@ -171,7 +175,11 @@ fn assert_spelled(png: &Pixmap, t: &Text, colour: [u8; 3]) {
             assert_eq!(rgb(png, x, y), want, "\"{}\" at ({x}, {y})", t.words);
         }
     }
-    assert!(inked > 10 && solid > 0, "\"{}\": {inked} pixels inked", t.words);
+    assert!(
+        inked > 10 && solid > 0,
+        "\"{}\": {inked} pixels inked",
+        t.words
+    );
 }
 
 /// The rows of the PNG that run through the whole colour ramp, as (y, left, right):
@@ -342,7 +350,11 @@ fn every_picture_has_a_length_scale_of_a_round_length_drawn_to_scale() {
         // Above it, the snapshot's time and its number of grains.
         let caption = texts(&group(&svg, "caption"));
         let caption = text(&caption, "caption");
-        assert_eq!(caption.words, format!("t = 12.5 √(σ/g) · {N} grains"), "{stem}");
+        assert_eq!(
+            caption.words,
+            format!("t = 12.5 √(σ/g) · {N} grains"),
+            "{stem}"
+        );
         assert_spelled(&png, caption, INK);
     }
 }
@@ -464,7 +476,10 @@ fn a_pressure_of_both_signs_is_drawn_on_a_map_centred_on_zero() {
         text(&words, "min").words.parse().unwrap(),
         text(&words, "max").words.parse().unwrap(),
     );
-    assert!(lo < 0.0 && (lo + hi).abs() < 1e-9, "symmetric: {lo} .. {hi}");
+    assert!(
+        lo < 0.0 && (lo + hi).abs() < 1e-9,
+        "symmetric: {lo} .. {hi}"
+    );
     assert_eq!(text(&words, "zero").words, "0");
     let stops: Vec<&str> = bar[0].split("stop-color=\"").skip(1).collect();
     for (k, s) in stops.iter().enumerate() {
@@ -477,10 +492,12 @@ fn a_pressure_of_both_signs_is_drawn_on_a_map_centred_on_zero() {
     // tension (red).
     let fills: Vec<[u8; 3]> = (svg.lines().filter(|l| l.starts_with("<circle")))
         .map(|l| {
-            let v: Vec<u8> = (attr(l, "fill").trim_start_matches("rgb(").trim_end_matches(')'))
-                .split(',')
-                .map(|v| v.parse().unwrap())
-                .collect();
+            let v: Vec<u8> = (attr(l, "fill")
+                .trim_start_matches("rgb(")
+                .trim_end_matches(')'))
+            .split(',')
+            .map(|v| v.parse().unwrap())
+            .collect();
             [v[0], v[1], v[2]]
         })
         .collect();
@@ -488,7 +505,10 @@ fn a_pressure_of_both_signs_is_drawn_on_a_map_centred_on_zero() {
     assert!(bottom[2] > bottom[0] + 50, "bottom blue: {bottom:?}");
     assert!(top[0] > top[2] + 50, "top red: {top:?}");
     let png = Pixmap::load_png(dir.join("grains.png")).unwrap();
-    assert!(!map_rows(&png, diverging).is_empty(), "the diverging bar in the PNG");
+    assert!(
+        !map_rows(&png, diverging).is_empty(),
+        "the diverging bar in the PNG"
+    );
     assert!(ramp_rows(&png).is_empty(), "no sequential bar");
     assert_spelled(&png, text(&words, "zero"), INK);
 }

@@ -224,9 +224,13 @@ fn pip_installs_the_reader_into_a_fresh_venv() {
     };
     if !(has("ensurepip") && has("setuptools")) {
         if std::env::var("TALUS_REQUIRE_PYTHON").as_deref() == Ok("1") {
-            panic!("no venv or setuptools (TALUS_REQUIRE_PYTHON=1): apt-get install python3-venv python3-setuptools");
+            panic!(
+                "no venv or setuptools (TALUS_REQUIRE_PYTHON=1): apt-get install python3-venv python3-setuptools"
+            );
         }
-        eprintln!("skipped: no venv or setuptools (apt-get install python3-venv python3-setuptools)");
+        eprintln!(
+            "skipped: no venv or setuptools (apt-get install python3-venv python3-setuptools)"
+        );
         return;
     }
     let dir = tmp("venv");
@@ -236,7 +240,11 @@ fn pip_installs_the_reader_into_a_fresh_venv() {
         .arg(&venv)
         .output()
         .unwrap();
-    assert!(o.status.success(), "venv: {}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "venv: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     // A copy of the package, so that the build leaves nothing in the checkout.
     let src = dir.join("python");
     std::fs::create_dir_all(src.join("talus")).unwrap();
@@ -256,7 +264,11 @@ fn pip_installs_the_reader_into_a_fresh_venv() {
         .env_remove("PYTHONPATH")
         .output()
         .unwrap();
-    assert!(o.status.success(), "pip install: {}", String::from_utf8_lossy(&o.stderr));
+    assert!(
+        o.status.success(),
+        "pip install: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     small_run(&dir);
     let o = Command::new(venv.join("bin/python"))
         .args([

@@ -183,7 +183,11 @@ pub(super) fn length_scale(c: &mut Canvas, unit: &str) {
 /// units (s, or √(σ/g) in reduced units) and its number of grains, fixed ones included.
 pub(super) fn caption(c: &mut Canvas, input: &Input) {
     let s = Strip::of(c);
-    let unit = if input.units == "si" { "s" } else { "√(σ/g)" };
+    let unit = if input.units == "si" {
+        "s"
+    } else {
+        "√(σ/g)"
+    };
     let words = format!(
         "t = {} {unit} · {} grains",
         number(input.time),

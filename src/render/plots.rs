@@ -198,8 +198,8 @@ fn plot_log_y(
     x0 = x0.min(0.0);
     framed(path, title, |mut builder| {
         let e = |x: &dyn std::fmt::Display| x.to_string();
-        let mut chart = (builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale()))
-            .map_err(|x| e(&x))?;
+        let mut chart =
+            (builder.build_cartesian_2d(x0..x1, (y0..y1).log_scale())).map_err(|x| e(&x))?;
         chart
             .configure_mesh()
             .x_desc(x.label())
@@ -213,7 +213,10 @@ fn plot_log_y(
             chart
                 .draw_series(LineSeries::new(line, c.stroke_width(2)))
                 .map_err(|x| e(&x))?;
-            let dots = data.iter().filter(shown).map(|&p| Circle::new(p, 3, c.filled()));
+            let dots = data
+                .iter()
+                .filter(shown)
+                .map(|&p| Circle::new(p, 3, c.filled()));
             chart.draw_series(dots).map_err(|x| e(&x))?;
         }
         Ok(())

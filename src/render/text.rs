@@ -51,7 +51,10 @@ pub fn has_glyph(c: char) -> bool {
 /// rounded up.
 pub fn width(text: &str, scale: u32) -> u32 {
     let px = font_size(scale);
-    let w: f32 = text.chars().map(|c| font().metrics(c, px).advance_width).sum();
+    let w: f32 = text
+        .chars()
+        .map(|c| font().metrics(c, px).advance_width)
+        .sum();
     w.ceil() as u32
 }
 
@@ -155,6 +158,9 @@ mod tests {
         // shades of pink at their edges.
         assert!(px.iter().all(|c| c.alpha() == 255));
         assert!(px.iter().any(|c| c.red() == 200 && c.green() == 0));
-        assert!(px.iter().any(|c| c.green() > 0 && c.green() < 255 && c.red() > 200));
+        assert!(
+            px.iter()
+                .any(|c| c.green() > 0 && c.green() < 255 && c.red() > 200)
+        );
     }
 }
