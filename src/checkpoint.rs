@@ -370,7 +370,10 @@ fn decode(
         p.material.push(d.u32().map_err(corrupt)?);
     }
     // A material the scene does not have would index past the law's pair table.
-    if p.material.iter().any(|&m| m as usize >= scene.materials.len()) {
+    if p.material
+        .iter()
+        .any(|&m| m as usize >= scene.materials.len())
+    {
         return Err(corrupt(crate::files::DecodeError(bytes.len())));
     }
     for _ in 0..n {
