@@ -161,7 +161,10 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
                              v_centres, v1.z + v2.z);
     let res = evaluate(input);
     let f = res.f_n * g.n + res.f_t * t;
-    contact_ft[slot] = vec4<f32>(f, cross2(l1, f), -cross2(l2, f));
+    // Paper 001 eq. 13 (src/forces.rs `contact_force`): both torques on the law's lever.
+    var torques = vec2<f32>(cross2(l1, f), -cross2(l2, f));
+    if (res.lever > 0.0) { torques = vec2<f32>(-res.lever * res.f_t); }
+    contact_ft[slot] = vec4<f32>(f, torques);
     // In place: the slot's spring is the list's history from step to step.
     hist_in[slot] = res.history;
     let finite = abs(f.x) <= 3.0e38 && abs(f.y) <= 3.0e38;

@@ -27,6 +27,9 @@ struct ContactOutput {
     f_t: f32,
     history: f32,
     energy: f32,
+    // The lever of f_t in both torques where the law sets one (paper 001 eq. 13: the
+    // centre distance); 0: the contact point's arms.
+    lever: f32,
 };
 
 fn pow_pos(x: f32, y: f32) -> f32 {
@@ -84,7 +87,7 @@ fn spring_dashpot(c: ContactInput) -> ContactOutput {
     if (params.clamp != 0u) { f_n = max(f_n, 0.0); }
     let t = coulomb_spring_with(c.history, c.v_t, c.dt, f_n, k.z, k.w, mu);
     let energy = elastic_energy(k.x, c.delta) + 0.5 * k.z * t.y * t.y;
-    return ContactOutput(f_n, t.x, t.y, energy);
+    return ContactOutput(f_n, t.x, t.y, energy, 0.0);
 }
 
 // Tapered friction, paper 001 eq. 5, and its stiffness, eq. 7.
@@ -163,7 +166,10 @@ fn continuous(c: ContactInput) -> ContactOutput {
     var f_t = -spring * sign(delta_f) - c_t * v_damped;
     if (delta_f == 0.0) { f_t = -c_t * v_damped; }
     let energy = continuous_energy(m, c.sigma, c.r, c.delta) + tapered_energy(delta_f, delta_max, mu_f_e);
-    return ContactOutput(f_n, f_t, delta_f, energy);
+    // Eq. 13: the torques on the lever eq. 6 gives the spins.
+    var lever = c.r;
+    if ((params.reading & READING_CONTACT_ARM) != 0u) { lever = 0.0; }
+    return ContactOutput(f_n, f_t, delta_f, energy, lever);
 }
 
 // Overlap-area law of polygons, paper 000 eq. 6-7 (src/law/overlap_area.rs): delta is
@@ -196,14 +202,14 @@ fn overlap_area(c: ContactInput) -> ContactOutput {
         if (k_t > 0.0) { xs = -f_t / k_t; }
     }
     let energy = 0.5 * f_el * c.r + 0.5 * k_t * xs * xs;
-    return ContactOutput(f_n, f_t, xs, energy);
+    return ContactOutput(f_n, f_t, xs, energy, 0.0);
 }
 
 // Paper 004's law (src/law/hertz_cohesive.rs): F_N = k^N delta^{3/2} + gamma^N m12
 // delta_dot, clamped at 0, a Coulomb-capped spring damped by gamma^T m12, and a constant
 // pull F_c = Bo g m while the gap is below d_c (delta > -d_c; `c.mass` is m).
 fn hertz_cohesive(c: ContactInput) -> ContactOutput {
-    if (!(c.delta > -params.d_c)) { return ContactOutput(0.0, 0.0, 0.0, 0.0); }
+    if (!(c.delta > -params.d_c)) { return ContactOutput(0.0, 0.0, 0.0, 0.0, 0.0); }
     let f_c = params.bond_g * c.mass;
     var f_rep = 0.0;
     var elastic = 0.0;
@@ -215,7 +221,7 @@ fn hertz_cohesive(c: ContactInput) -> ContactOutput {
         t = damped_coulomb_spring(c.history, c.v_t, c.dt, f_rep, params.gamma_t * c.m12);
     }
     let energy = elastic + 0.5 * params.k_t * t.y * t.y - f_c * (c.delta + params.d_c);
-    return ContactOutput(f_rep - f_c, t.x, t.y, energy);
+    return ContactOutput(f_rep - f_c, t.x, t.y, energy, 0.0);
 }
 
 // The law a pipeline is built for (`Build::law`, src/gpu/kernels.rs). The contact

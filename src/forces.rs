@@ -118,15 +118,19 @@ fn contact_force(
     ];
     let i = pair.i as usize;
     let p = particles.position(i);
-    let torque_j = if pair.is_wall() {
-        0.0
+    let torque = if res.lever > 0.0 {
+        // Paper 001 eq. 13: T = r_ij × F_ij on both disks, the lever eq. 6 gives the
+        // spins, so that the spring's work matches δ_F's (the normal force is central).
+        [-res.lever * res.f_t, res.lever * res.f_t]
+    } else if pair.is_wall() {
+        [cross(g.arm, force), 0.0]
     } else {
         let d = offset(particles, i, pair.j as usize);
-        cross([g.arm[0] + d[0], g.arm[1] + d[1]], force)
+        [cross(g.arm, force), cross([g.arm[0] + d[0], g.arm[1] + d[1]], force)]
     };
     let c = ContactForce {
         force,
-        torque: [cross(g.arm, force), torque_j],
+        torque,
         point: [p[0] + g.arm[0], p[1] + g.arm[1]],
         arm: g.arm,
         n: g.n,
@@ -973,6 +977,7 @@ mod tests {
             f_t,
             history: 0.0,
             energy: 0.0,
+            lever: 0.0,
         };
         (c, r)
     }

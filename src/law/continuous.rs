@@ -159,6 +159,10 @@ impl Continuous {
             f_t,
             history: delta_f,
             energy,
+            lever: match self.reading.arm {
+                RollingArm::CentreDistance => c.r,
+                RollingArm::ContactPoint => 0.0,
+            },
         }
     }
 

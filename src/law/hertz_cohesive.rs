@@ -131,6 +131,7 @@ impl HertzCohesive {
             history,
             // The cohesive pull's potential, −F_c (δ + d_c), counts with the rest.
             energy: elastic + spring_energy(self.k_t, history) - f_c * (delta + self.d_c),
+            lever: 0.0,
         }
     }
 }

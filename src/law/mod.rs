@@ -59,6 +59,9 @@ pub struct ContactOutput {
     pub history: f64,
     /// Elastic energy stored in the contact (normal + tangential).
     pub energy: f64,
+    /// The lever of f_t in both torques where the law sets one (paper 001 eq. 13: the
+    /// centre distance r_ij); 0: the contact point's arms.
+    pub lever: f64,
 }
 
 /// One contact law's per-contact function, for loops specialised to the law (the force

@@ -221,6 +221,7 @@ impl OverlapArea {
             f_t,
             history: xi,
             energy,
+            lever: 0.0,
         }
     }
 

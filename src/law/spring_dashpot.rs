@@ -251,6 +251,7 @@ impl SpringDashpot {
             f_t,
             history: xi,
             energy,
+            lever: 0.0,
         }
     }
 

@@ -213,7 +213,7 @@ pub struct ContinuousSpec {
     /// The velocity the tangential damping of eq. 4 acts on.
     #[serde(default)]
     pub tangential_damping: TangentialDamping,
-    /// The arm of the disks' spin in eq. 6's slip.
+    /// The arm of the disks' spins in eq. 6's slip and of f_t in eq. 13's torques.
     #[serde(default)]
     pub rolling_arm: RollingArm,
 }
@@ -247,7 +247,7 @@ pub struct HookeEquivalentSpec {
     /// The velocity the tangential damping of eq. 4 acts on.
     #[serde(default)]
     pub tangential_damping: TangentialDamping,
-    /// The arm of the disks' spin in eq. 6's slip.
+    /// The arm of the disks' spins in eq. 6's slip and of f_t in eq. 13's torques.
     #[serde(default)]
     pub rolling_arm: RollingArm,
 }
@@ -266,11 +266,15 @@ pub enum TangentialDamping {
     Slip,
 }
 
-/// The arm of the spins in paper 001 eq. 6's slip, δ_F = ∫ ṙ_ij · t̂ − (θ̇_i + θ̇_j) a.
+/// The arm of the spins in paper 001 eq. 6's slip, δ_F = ∫ ṙ_ij · t̂ − (θ̇_i + θ̇_j) a,
+/// and of the tangential force in eq. 13's torques, T_i = T_j = −a f_t: one lever for
+/// both, so that the spring does the work δ_F stores.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RollingArm {
-    /// a = r_ij, the centre distance, as eq. 6 writes it: twice the physical arm.
+    /// a = r_ij, the centre distance, as eq. 6 and 13 write it: twice the physical arm
+    /// (until stop 53 the torques stayed on the contact point, and the law was not
+    /// conservative: `tests/laws.rs`).
     #[default]
     CentreDistance,
     /// Each disk's own distance to the contact point (σ/2 for equal disks): the surfaces'
