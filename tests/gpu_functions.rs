@@ -159,10 +159,20 @@ fn wgsl_laws_match_their_rust_twins() {
     let d = bitcast<vec4<f32>>(wgsl_arg(k, 3u));
     let r = evaluate(ContactInput(a.x, a.y, a.z, a.w, b.x, b.y, b.z, b.w, c.x, c.y,
                                   bitcast<u32>(c.z), c.w, d.x));
-    wgsl_put(k, 0u, bitcast<vec4<u32>>(vec4<f32>(r.f_n, r.f_t, r.history, r.energy)));";
-        let Some(out) = run_wgsl_fn(name, &[COMMON, LAWS], &params, (4, 1), body, &words) else {
+    wgsl_put(k, 0u, bitcast<vec4<u32>>(vec4<f32>(r.f_n, r.f_t, r.history, r.energy)));
+    wgsl_put(k, 1u, bitcast<vec4<u32>>(vec4<f32>(r.lever, 0.0, 0.0, 0.0)));";
+        let Some(out) = run_wgsl_fn(name, &[COMMON, LAWS], &params, (4, 2), body, &words) else {
             return;
         };
+        // The torques' lever (paper 001 eq. 13): r in f32, or 0 for the contact point.
+        for (k, (c, w)) in cases.iter().zip(out.chunks(2)).enumerate() {
+            let (cpu, gpu) = (law.evaluate(c).lever, f32::from_bits(w[1][0]) as f64);
+            assert!(
+                (gpu - cpu).abs() <= 1e-6 * cpu,
+                "{name}: case {k}: lever CPU {cpu}, GPU {gpu}"
+            );
+        }
+        let out: Vec<[u32; 4]> = out.into_iter().step_by(2).collect();
         let cpu: Vec<[f64; 4]> = (cases.iter())
             .map(|c| {
                 let r = law.evaluate(c);
