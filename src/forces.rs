@@ -118,19 +118,13 @@ fn contact_force(
     ];
     let i = pair.i as usize;
     let p = particles.position(i);
-    let torque = if res.lever > 0.0 {
-        // Paper 001 eq. 13: T = r_ij × F_ij on both disks, the lever eq. 6 gives the
-        // spins, so that the spring's work matches δ_F's (the normal force is central).
-        [-res.lever * res.f_t, res.lever * res.f_t]
-    } else if pair.is_wall() {
-        [cross(g.arm, force), 0.0]
-    } else {
+    let arm_j = (!pair.is_wall()).then(|| {
         let d = offset(particles, i, pair.j as usize);
-        [cross(g.arm, force), cross([g.arm[0] + d[0], g.arm[1] + d[1]], force)]
-    };
+        [g.arm[0] + d[0], g.arm[1] + d[1]]
+    });
     let c = ContactForce {
         force,
-        torque,
+        torque: res.torques(force, g.arm, arm_j),
         point: [p[0] + g.arm[0], p[1] + g.arm[1]],
         arm: g.arm,
         n: g.n,

@@ -326,7 +326,11 @@ fn pocket_energy_excursion(path: Path, reading: serde_json::Value) -> Option<(f6
     let (mut lo, mut hi) = (1.0, 1.2);
     for _ in 0..60 {
         let mid = 0.5 * (lo + hi);
-        if weight_carried(mid) > 0.0 { lo = mid } else { hi = mid }
+        if weight_carried(mid) > 0.0 {
+            lo = mid
+        } else {
+            hi = mid
+        }
     }
     let z = (lo * lo - 0.3025f64).sqrt();
     let mut v = scene_value(
@@ -350,7 +354,11 @@ fn pocket_energy_excursion(path: Path, reading: serde_json::Value) -> Option<(f6
     let (e0, k0) = (total(s), s.energies().kinetic());
     let (mut worst, mut spin): (f64, f64) = (0.0, 0.0);
     // The GPU path (a readback per sample) over 5 time units, sampled every 1000 steps.
-    let (samples, every) = if path == Path::Cpu { (1000, 200) } else { (50, 1000) };
+    let (samples, every) = if path == Path::Cpu {
+        (1000, 200)
+    } else {
+        (50, 1000)
+    };
     for _ in 0..samples {
         e.advance(every).unwrap();
         let s = e.sim().unwrap();
@@ -378,8 +386,14 @@ fn continuous_law_conserves_energy_with_spins_on_both_levers() {
                 continue;
             };
             eprintln!("{path:?} {reading}: energy excursion {worst:.2e}, spin up to {spin:.3}");
-            assert!(spin > 0.01, "{path:?} {reading}: the disk must spin ({spin})");
-            assert!(worst < 1e-2, "{path:?} {reading}: energy moved by {worst:.3e} of the input");
+            assert!(
+                spin > 0.01,
+                "{path:?} {reading}: the disk must spin ({spin})"
+            );
+            assert!(
+                worst < 1e-2,
+                "{path:?} {reading}: energy moved by {worst:.3e} of the input"
+            );
         }
     }
 }

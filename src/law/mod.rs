@@ -64,6 +64,20 @@ pub struct ContactOutput {
     pub lever: f64,
 }
 
+impl ContactOutput {
+    /// The torques about i's centre and about j's (`forces::ContactForce::torque`): F at
+    /// the contact point, whose arms from the centres are `arm_i` and `arm_j` (none for a
+    /// wall), or f_t on the law's lever, the same on both disks (paper 001 eq. 13; the
+    /// normal force of two disks is central).
+    pub fn torques(&self, force: [f64; 2], arm_i: [f64; 2], arm_j: Option<[f64; 2]>) -> [f64; 2] {
+        use crate::geometry::cross;
+        if self.lever > 0.0 {
+            return [-self.lever * self.f_t, self.lever * self.f_t];
+        }
+        [cross(arm_i, force), arm_j.map_or(0.0, |a| cross(a, force))]
+    }
+}
+
 /// One contact law's per-contact function, for loops specialised to the law (the force
 /// stage dispatches on [`ContactLaw`] once per step, not once per contact).
 pub trait Law: Sync {
