@@ -9,7 +9,7 @@
 
 use crate::contacts::{Pair, WALL_BASE};
 use crate::geometry::{
-    Geometry, WallSegment, cross, disk_disk, disk_wall, spin_velocity, tangent, wall_from,
+    Geometry, WallSegment, disk_disk, disk_wall, spin_velocity, tangent, wall_from,
 };
 use crate::law::hertz_cohesive::HertzCohesive;
 use crate::law::{ContactInput, ContactLaw, ContactOutput, Law};
@@ -942,14 +942,12 @@ pub fn reduce_forces(
         let acc = &mut out[i];
         acc[0] += c.force[0];
         acc[1] += c.force[1];
-        acc[2] += cross(c.arm, c.force);
+        acc[2] += c.torque[0];
         if !pair.is_wall() {
-            let j = pair.j as usize;
-            let d = offset(particles, i, j);
-            let acc = &mut out[j];
+            let acc = &mut out[pair.j as usize];
             acc[0] -= c.force[0];
             acc[1] -= c.force[1];
-            acc[2] -= cross([c.arm[0] + d[0], c.arm[1] + d[1]], c.force);
+            acc[2] -= c.torque[1];
         }
     }
 }

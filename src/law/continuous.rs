@@ -159,6 +159,8 @@ impl Continuous {
             f_t,
             history: delta_f,
             energy,
+            // Eq. 13: the torques on the lever eq. 6 gives the spins, so that the spring's
+            // work is what δ_F stores (tests/laws.rs, the pocket).
             lever: match self.reading.arm {
                 RollingArm::CentreDistance => c.r,
                 RollingArm::ContactPoint => 0.0,
