@@ -11,9 +11,10 @@
 //! PILE_ONLY=1 skips the heap.
 
 use std::time::Instant;
+use talus::cpu::orientation::RotatedCorners;
 use talus::overlap::{AreaContact, Hint, Seen, polygon_polygon_hinted};
 use talus::scene;
-use talus::shape::{P2, RotatedCorners};
+use talus::shape::P2;
 use talus::sim::Simulation;
 
 /// The polygon–polygon candidates of a state: (i, j, d = r_i − r_j).
@@ -26,7 +27,7 @@ fn candidates(sim: &mut Simulation) -> Vec<(usize, usize, P2)> {
         })
         .map(|pair| {
             let (i, j) = (pair.i as usize, pair.j as usize);
-            (i, j, talus::forces::offset(p, i, j))
+            (i, j, talus::state::offset(p, i, j))
         })
         .collect()
 }

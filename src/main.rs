@@ -1,8 +1,7 @@
-//! The `talus` binary: parse arguments → run → exit code (see cli.rs).
+//! The `talus` binary: parse arguments → run → exit code (see cli/mod.rs).
 
 fn main() -> std::process::ExitCode {
-    talus_cli::main()
+    cli::main()
 }
 
-#[path = "cli.rs"]
-mod talus_cli;
+mod cli;

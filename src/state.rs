@@ -70,7 +70,7 @@ impl Particles {
         let id = self.len() as u32;
         let (mass, inertia) = if d.sweep > 0.0 {
             // A spheropolygon: the exact area and moment of the swept shape.
-            let s = crate::spheropolygon::Spheropolygon {
+            let s = crate::shape::spheropolygon::Spheropolygon {
                 core: d.corners.clone(),
                 radius: d.sweep,
             };
@@ -141,7 +141,6 @@ impl Particles {
     /// Puts the particles in a new memory order: `order[new] = old` index (a
     /// permutation of 0..len).
     pub fn permute(&mut self, order: &[u32]) {
-        use crate::neighbours::gather;
         assert_eq!(order.len(), self.len());
         for q in &mut self.q {
             *q = gather(q, order);
@@ -207,4 +206,17 @@ impl Particles {
     pub fn max_radius(&self) -> f64 {
         self.radius.iter().copied().fold(0.0, f64::max)
     }
+}
+
+/// r_i − r_j: the offset of the pair, the only way positions enter a contact's geometry
+/// (issue 18).
+#[inline]
+pub fn offset(particles: &Particles, i: usize, j: usize) -> [f64; 2] {
+    let (pi, pj) = (particles.position(i), particles.position(j));
+    [pi[0] - pj[0], pi[1] - pj[1]]
+}
+
+/// `v` in a new order: `out[k] = v[from[k]]`.
+pub fn gather<T: Copy>(v: &[T], from: &[u32]) -> Vec<T> {
+    from.iter().map(|&k| v[k as usize]).collect()
 }

@@ -24,7 +24,7 @@ fn analyse_with(
     g: f64,
     opt: &Options,
 ) -> analyze::Analysis {
-    let json = talus::snapshot::write(sim, dir, "snap").unwrap();
+    let json = talus::io::snapshot::write(sim, dir, "snap").unwrap();
     let input = analyze::input::load(&json, Some(g)).unwrap();
     analyze::analyze(input, opt).unwrap()
 }
@@ -201,7 +201,7 @@ fn aligned_ellipse_polygons_peak_in_f_theta_and_correlate_fully() {
 fn the_command_writes_its_tables_and_rejects_bad_input() {
     let s = settled_column();
     let dir = tmp("command");
-    let json = talus::snapshot::write(&s, &dir, "snap").unwrap();
+    let json = talus::io::snapshot::write(&s, &dir, "snap").unwrap();
     let run = |args: &[&str]| {
         let out = std::process::Command::new(common::talus_bin())
             .args(args)
@@ -263,8 +263,8 @@ fn damaged_snapshots_are_refused_by_analyze_and_render() {
     // a message (exit 2), neither indexed out of bounds nor drawn.
     let s = settled_column();
     let dir = tmp("damaged");
-    let json = talus::snapshot::write(&s, &dir, "snap").unwrap();
-    assert!(talus::snapshot::read(&json).is_ok());
+    let json = talus::io::snapshot::write(&s, &dir, "snap").unwrap();
+    assert!(talus::io::snapshot::read(&json).is_ok());
     let mut meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     // As a file from before the checksum (version 1, still read), so that the checks of
@@ -329,7 +329,7 @@ fn damaged_snapshots_are_refused_by_analyze_and_render() {
         let d = tmp(&format!("damaged-{name}"));
         std::fs::write(d.join("snap.json"), m.to_string()).unwrap();
         std::fs::write(d.join("snap.bin"), &b).unwrap();
-        let e = (talus::snapshot::read(&d.join("snap.json")).err()).map(|e| e.to_string());
+        let e = (talus::io::snapshot::read(&d.join("snap.json")).err()).map(|e| e.to_string());
         assert!(
             e.as_deref().is_some_and(|e| e.contains(must)),
             "{name}: {e:?}"
@@ -350,7 +350,7 @@ fn damaged_snapshots_are_refused_by_analyze_and_render() {
 fn render_draws_pictures_and_vtk_files_of_the_column() {
     let s = settled_column();
     let dir = tmp("render");
-    let json = talus::snapshot::write(&s, &dir, "snap").unwrap();
+    let json = talus::io::snapshot::write(&s, &dir, "snap").unwrap();
     let out = dir.join("pictures");
     let o = std::process::Command::new(common::talus_bin())
         .args([
@@ -479,7 +479,7 @@ fn stresses_average_over_snapshots() {
     // The same column twice, once with every contact force tripled: the averaged
     // stress tables are twice the single one; everything else is the last snapshot's.
     let s = settled_column();
-    let json = talus::snapshot::write(&s, &tmp("series"), "snap").unwrap();
+    let json = talus::io::snapshot::write(&s, &tmp("series"), "snap").unwrap();
     let one = analyze::input::load(&json, Some(1.0)).unwrap();
     let mut tripled = one.clone();
     tripled.touches.iter_mut().for_each(|t| {
@@ -1031,7 +1031,7 @@ fn the_base_load_summary_tells_an_m_from_force_chain_noise() {
     // times 1 + 0.1 N(0, 1): a = 3.3 is a broad M (maxima 40 % above the centre), a = 0
     // a parabola. The summary carries standard errors and a verdict: M with z > 2 for
     // the first, not M for the second; the same input gives the same bytes.
-    let mut rng = talus::rng::Rng::new(42);
+    let mut rng = talus::base::rng::Rng::new(42);
     let mut normal = || {
         let u = 1.0 - rng.uniform();
         (-2.0 * u.ln()).sqrt() * (2.0 * std::f64::consts::PI * rng.uniform()).cos()
@@ -1129,10 +1129,10 @@ fn vtk_draws_disks_as_points_and_polygons_as_their_outlines() {
     let mut s = common::sim(&v);
     s.advance(400).unwrap();
     let dir = tmp("vtk-mixed");
-    let json_path = talus::snapshot::write(&s, &dir, "snap").unwrap();
+    let json_path = talus::io::snapshot::write(&s, &dir, "snap").unwrap();
     let out = dir.join("pictures");
     render(&json_path, &out);
-    let snap = talus::snapshot::read(&json_path).unwrap();
+    let snap = talus::io::snapshot::read(&json_path).unwrap();
     let vtp = common::vtp::read(&out.join("grains.vtp"));
     assert_eq!(
         (vtp.count("NumberOfVerts"), vtp.count("NumberOfPolys")),
@@ -1250,11 +1250,11 @@ fn render_writes_a_lammps_style_dump_that_holds_the_snapshot_exactly() {
     let mut s = common::sim(&common::disks_and_a_pentagon());
     s.advance(400).unwrap();
     let dir = tmp("dump");
-    let json_path = talus::snapshot::write(&s, &dir, "snap").unwrap();
+    let json_path = talus::io::snapshot::write(&s, &dir, "snap").unwrap();
     let out = dir.join("pictures");
     render(&json_path, &out);
     let d = Dump::read(&out.join("grains.dump"));
-    let snap = talus::snapshot::read(&json_path).unwrap();
+    let snap = talus::io::snapshot::read(&json_path).unwrap();
     assert_eq!(d.step, 400);
     assert_eq!(d.time, snap.meta.time);
     for c in [

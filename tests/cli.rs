@@ -580,7 +580,7 @@ fn every_output_says_what_wrote_it() {
     // threads and the backend.
     let (code, version, err) = talus(&["--version"]);
     assert_eq!(code, 0, "{err}");
-    let commit = talus::provenance::COMMIT;
+    let commit = talus::base::provenance::COMMIT;
     assert_eq!(
         version.trim(),
         format!("talus {} (commit {commit})", env!("CARGO_PKG_VERSION"))
@@ -638,7 +638,7 @@ fn every_output_says_what_wrote_it() {
         assert!(line.contains(&"stop.time=0.2"), "{what}: {p}");
     }
     // The snapshots still read (the checksum covers the provenance too).
-    talus::snapshot::read(&out.join("final.json")).unwrap();
+    talus::io::snapshot::read(&out.join("final.json")).unwrap();
     let log = std::fs::read_to_string(out.join("log.csv")).unwrap();
     let first = log.lines().next().unwrap();
     assert!(

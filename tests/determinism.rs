@@ -4,10 +4,10 @@
 
 mod common;
 use std::path::Path;
+use talus::io::snapshot::{self, Column};
 use talus::run::{RunOptions, run};
 use talus::scene;
 use talus::sim::Simulation;
-use talus::snapshot::{self, Column};
 
 /// The default heap, shortened: a point source pouring onto a bumpy row with friction.
 fn small_heap(extra: &[&str]) -> talus::scene::Scene {
@@ -98,7 +98,7 @@ fn resume_from_checkpoint_is_bitwise_identical() {
     // Resumed at t = 15 (step 7500), with the heap still forming, to t = 30.
     for path in common::PATHS {
         let test = "resume_from_checkpoint_is_bitwise_identical";
-        let check = |c: &talus::checkpoint::Checkpoint| {
+        let check = |c: &talus::io::checkpoint::Checkpoint| {
             let springs = c.sim.springs.len();
             assert!(springs > 0, "the checkpoint carries tangential springs");
         };
@@ -144,7 +144,7 @@ fn polygon_scene() -> talus::scene::Scene {
 #[test]
 fn polygon_runs_resume_bitwise() {
     // CPU only: the GPU path does not take point sources beside layered blocks yet.
-    let check = |c: &talus::checkpoint::Checkpoint| {
+    let check = |c: &talus::io::checkpoint::Checkpoint| {
         let p = &c.sim.particles;
         let shapes = p.shape.iter().all(|c| c.len() == 7 || c.len() == 5);
         assert!(shapes, "the checkpoint carries the polygons");

@@ -206,7 +206,7 @@ fn what_the_wgsl_takes_for_granted() {
     }
     // common.wgsl holds a pair's sub-contact springs in a vec4 (`SubSprings`).
     assert_eq!(
-        talus::spheropolygon::MAX_SUB,
+        talus::cpu::springs::MAX_SUB,
         4,
         "SubSprings holds MAX_SUB in a vec4"
     );

@@ -6,9 +6,9 @@ mod common;
 
 use common::wgsl::{COMMON, LAWS, floats, run_wgsl_fn, word};
 use serde_json::json;
+use talus::base::rng::Rng;
 use talus::gpu::layout::{Params, hash_pair};
 use talus::law::{ContactInput, ContactLaw};
-use talus::rng::Rng;
 
 /// The law of a contact block (gravity 1, so that the continuous laws' force scale m g
 /// is the mass).

@@ -6,15 +6,15 @@ mod common;
 
 use serde_json::json;
 use std::collections::BTreeMap;
-use talus::cell_list::{CellList, Grid, prefix_sum};
-use talus::contacts::{Pair, find_contacts};
-use talus::forces::{contact_forces, reduce_forces};
+use talus::base::rng::Rng;
+use talus::cpu::cell_list::{CellList, Grid, prefix_sum};
+use talus::cpu::contacts::{Pair, find_contacts};
+use talus::cpu::forces::{contact_forces, reduce_forces};
+use talus::cpu::orientation::{RotatedCorners, rotate_corners};
 use talus::gpu::kernels::Kernel;
 use talus::gpu::layout::control::REBUILD;
 use talus::gpu::layout::{Entry, MAX_CONTACTS};
 use talus::gpu::{GpuSimulation, REBUILD_STAGES, workgroups};
-use talus::rng::Rng;
-use talus::shape::{RotatedCorners, rotate_corners};
 
 /// `n` disks of diameter 0.8–1.2 on a jittered lattice in a box with walls, some
 /// overlapping, with random velocities and spins; every 7th one fixed.
@@ -264,7 +264,7 @@ fn cpu_contact_forces(
     host: &talus::sim::Simulation,
     pairs: &[Pair],
     history: &[f64],
-) -> (Vec<talus::forces::ContactForce>, Vec<f64>) {
+) -> (Vec<talus::cpu::forces::ContactForce>, Vec<f64>) {
     let (mut cpu, mut hist_out) = (Vec::new(), Vec::new());
     let mut shapes = RotatedCorners::default();
     rotate_corners(&host.particles, &mut shapes);
@@ -1017,7 +1017,7 @@ fn degenerate_polygon_contacts_vary_continuously_on_the_gpu() {
                 "{name}: step {k} not finite"
             );
             gpu_f.push(f);
-            let d = talus::forces::offset(&host.particles, i, i + 1);
+            let d = talus::state::offset(&host.particles, i, i + 1);
             cpu_f.push(match polygon_polygon(shapes.of(i), shapes.of(i + 1), d) {
                 Some(c) => [c.area / c.l * c.n[0], c.area / c.l * c.n[1]],
                 None => [0.0, 0.0],

@@ -17,7 +17,7 @@ mod common;
 use common::pairs::{Config, Kind, PairSet, along_a_long_wall, pair_set};
 use serde_json::json;
 use std::collections::BTreeMap;
-use talus::forces::area_contact;
+use talus::cpu::forces::area_contact;
 use talus::gpu::GpuSimulation;
 use talus::gpu::kernels::Kernel;
 use talus::sim::Simulation;
@@ -269,8 +269,8 @@ fn gpu_snapshots_hold_the_devices_contacts() {
     };
     let dir = std::env::temp_dir().join(format!("talus-gpu-snapshot-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let path = talus::snapshot::write(&gpu, &dir, "gpu").expect("snapshot written");
-    let snap = talus::snapshot::read(&path).expect("snapshot read");
+    let path = talus::io::snapshot::write(&gpu, &dir, "gpu").expect("snapshot written");
+    let snap = talus::io::snapshot::read(&path).expect("snapshot read");
     let col = |k: &str| snap.f64(k).unwrap().to_vec();
     let (nx, nz, px, pz) = (
         col("contacts.nx"),

@@ -7,8 +7,8 @@ mod common;
 
 use serde_json::{Value, json};
 use std::collections::BTreeMap;
+use talus::base::rng::Rng;
 use talus::gpu::GpuSimulation;
-use talus::rng::Rng;
 use talus::sim::Simulation;
 
 /// `rows` × `cols` rods of aspect 4 and width 0.9–1.0 in rows, turned by up to

@@ -15,7 +15,7 @@ use serde_json::{Value, json};
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
-use talus::rng::Rng;
+use talus::base::rng::Rng;
 use talus::scene::{self, SceneError};
 use talus::sim::Simulation;
 
@@ -378,7 +378,7 @@ fn make_checkpoints() -> Vec<(&'static str, Vec<u8>)> {
                 "rods: the state has sub-contact springs"
             );
         }
-        (name, talus::checkpoint::encode(&sim, None))
+        (name, talus::io::checkpoint::encode(&sim, None))
     })
     .collect()
 }
@@ -388,7 +388,7 @@ fn make_checkpoints() -> Vec<(&'static str, Vec<u8>)> {
 fn read_checkpoint(file: &Path, bytes: &[u8], steps: u64) -> Result<Result<(), String>, String> {
     std::fs::write(file, bytes).unwrap();
     let resume = || {
-        let mut sim = talus::checkpoint::read(file, &[])
+        let mut sim = talus::io::checkpoint::read(file, &[])
             .map_err(|e| e.to_string())?
             .sim;
         // A divergence is an answer too; only a panic is not.
@@ -652,10 +652,10 @@ fn assert_whole(dir: &Path) -> (usize, usize) {
                 assert!(text.ends_with('\n'), "{shown}: whole lines");
             }
             (_, "json") => {
-                talus::snapshot::read(p).unwrap_or_else(|e| panic!("{e}"));
+                talus::io::snapshot::read(p).unwrap_or_else(|e| panic!("{e}"));
             }
             (_, "bin") if name.starts_with("ckpt_") => {
-                talus::checkpoint::read(p, &[]).unwrap_or_else(|e| panic!("{e}"));
+                talus::io::checkpoint::read(p, &[]).unwrap_or_else(|e| panic!("{e}"));
             }
             (_, "bin") => {
                 let json_written = p.with_extension("json").is_file();

@@ -92,7 +92,7 @@ fn built_pile(row_height: Option<f64>) -> (f64, f64, f64, usize) {
         row_height.is_some()
     ));
     std::fs::create_dir_all(&dir).unwrap();
-    let json = talus::snapshot::write(&s, &dir, "built").unwrap();
+    let json = talus::io::snapshot::write(&s, &dir, "built").unwrap();
     let input = talus::analyze::input::load(&json, Some(1.0)).unwrap();
     let a = talus::analyze::analyze(input, &Default::default()).unwrap();
     let sm = a.summary;

@@ -1,12 +1,13 @@
 //! The cell list (counting sort) finds exactly the brute-force contacts (SPEC 3), and
 //! so do the neighbour lists with a skin between their rebuilds (issue 13).
 
-use talus::cell_list::{CellList, Grid};
-use talus::contacts::{brute_force_contacts, find_contacts, interacts, touches_wall};
-use talus::geometry::WallSegment;
-use talus::neighbours::NeighbourList;
-use talus::rng::Rng;
-use talus::shape::{RotatedCorners, circumradius, ellipse_polygon, rotate_corners};
+use talus::base::geometry::WallSegment;
+use talus::base::rng::Rng;
+use talus::cpu::cell_list::{CellList, Grid};
+use talus::cpu::contacts::{brute_force_contacts, find_contacts, interacts, touches_wall};
+use talus::cpu::neighbours::NeighbourList;
+use talus::cpu::orientation::{RotatedCorners, rotate_corners};
+use talus::shape::{circumradius, ellipse_polygon};
 use talus::state::{NewParticle, Particles};
 
 /// A random polydisperse packing: `n` disks (or polygons of 3 to 8 corners on ellipses)
@@ -92,13 +93,13 @@ fn listed_contacts(
     shapes: &RotatedCorners,
     walls: &[WallSegment],
     range: f64,
-) -> Vec<talus::contacts::Pair> {
+) -> Vec<talus::cpu::contacts::Pair> {
     list.pairs
         .iter()
         .copied()
         .filter(|q| {
             if q.is_wall() {
-                let w = &walls[(q.j - talus::contacts::WALL_BASE) as usize];
+                let w = &walls[(q.j - talus::cpu::contacts::WALL_BASE) as usize];
                 touches_wall(p, shapes, range, q.i as usize, w)
             } else {
                 interacts(p, shapes, range, q.i as usize, q.j as usize)
@@ -127,7 +128,7 @@ fn neighbour_lists_hold_every_contact_until_a_particle_moves_half_the_skin() {
         let mut shapes = RotatedCorners::default();
         rotate_corners(&p, &mut shapes);
         let mut list = NeighbourList::default();
-        let table = talus::springs::SpringTable::default();
+        let table = talus::cpu::springs::SpringTable::default();
         let max_d = 2.0 * p.max_radius();
         let ids: Vec<u32> = (0..p.len() as u32).collect();
         list.rebuild(
@@ -200,7 +201,7 @@ fn neighbour_lists_in_any_memory_order_hold_the_same_pairs_in_the_same_order() {
     for seed in 0..6 {
         let polygons = seed % 2 == 1;
         let p = packing(200 + seed, 400, polygons);
-        let table = talus::springs::SpringTable::default();
+        let table = talus::cpu::springs::SpringTable::default();
         let domain = ([0.0, 30.0], [0.0, 20.0]);
         let build = |p: &Particles, ids: &[u32]| {
             let mut list = NeighbourList::default();
@@ -228,12 +229,13 @@ fn neighbour_lists_in_any_memory_order_hold_the_same_pairs_in_the_same_order() {
         let list = build(&shuffled, &order);
         for id in 0..p.len() {
             let slot = order.iter().position(|&o| o as usize == id).unwrap();
-            let mine = |l: &NeighbourList, s: usize, ids: &[u32]| -> Vec<talus::contacts::Pair> {
-                l.pairs[l.start[s] as usize..l.start[s + 1] as usize]
-                    .iter()
-                    .map(|&q| talus::neighbours::id_pair(q, ids))
-                    .collect()
-            };
+            let mine =
+                |l: &NeighbourList, s: usize, ids: &[u32]| -> Vec<talus::cpu::contacts::Pair> {
+                    l.pairs[l.start[s] as usize..l.start[s + 1] as usize]
+                        .iter()
+                        .map(|&q| talus::cpu::neighbours::id_pair(q, ids))
+                        .collect()
+                };
             assert_eq!(
                 mine(&list, slot, &order),
                 mine(&plain, id, &identity),

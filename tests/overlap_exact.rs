@@ -8,8 +8,8 @@
 use num_bigint::BigInt;
 use num_rational::BigRational;
 use num_traits::{Signed, ToPrimitive, Zero};
+use talus::base::rng::Rng;
 use talus::overlap::{AreaContact, Hint, Outline, Seen, THICKNESS_FLOOR, polygon_polygon_hinted};
-use talus::rng::Rng;
 use talus::shape::{P2, ellipse_polygon, rotate};
 
 type Q = BigRational;

@@ -5,7 +5,7 @@
 mod common;
 use common::*;
 use serde_json::json;
-use talus::rng::Rng;
+use talus::base::rng::Rng;
 use talus::shape::{P2, area, ellipse_polygon, world};
 
 /// The overlap area by a different construction than clipping: the convex hull of every
@@ -219,7 +219,7 @@ fn swapping_the_two_polygons_gives_equal_and_opposite_forces() {
     // its arm) from the common force point: angular momentum about the origin is
     // conserved, τ_A + τ_B + r_A × F + r_B × (−F) = 0.
     let cross = |l: [f64; 2], f: [f64; 2]| l[0] * f[1] - l[1] * f[0];
-    let at = |c: &talus::forces::ContactForce| [c.point[0] - c.arm[0], c.point[1] - c.arm[1]];
+    let at = |c: &talus::cpu::forces::ContactForce| [c.point[0] - c.arm[0], c.point[1] - c.arm[1]];
     let tau_a = cross(c1.arm, c1.force);
     let tau_b = cross(c2.arm, c2.force);
     let total = tau_a + tau_b + cross(at(&c1), c1.force) + cross(at(&c2), c2.force);

@@ -8,13 +8,14 @@ mod common;
 use common::pairs::{Config, GAPS, Kind, PairSet, pair_set};
 use serde_json::json;
 use std::collections::BTreeMap;
-use talus::contacts::Pair;
-use talus::forces::{ContactForce, area_contact, offset};
-use talus::geometry::WallSegment;
+use talus::base::geometry::WallSegment;
+use talus::base::rng::Rng;
+use talus::cpu::contacts::Pair;
+use talus::cpu::forces::{ContactForce, area_contact};
 use talus::overlap::{polygon_polygon, polygon_wall};
-use talus::rng::Rng;
 use talus::shape::{P2, ellipse_polygon, rotate};
 use talus::sim::Simulation;
+use talus::state::offset;
 
 const K_N: f64 = 1e7;
 
@@ -117,7 +118,7 @@ fn contacts_are_the_same_after_translations_that_are_exact() {
 fn offset_change(origin: &Simulation, moved: &Simulation, p: Pair) -> f64 {
     let i = p.i as usize;
     if p.is_wall() {
-        let w = (p.j - talus::contacts::WALL_BASE) as usize;
+        let w = (p.j - talus::cpu::contacts::WALL_BASE) as usize;
         let rel = |s: &Simulation| {
             let (c, wall): ([f64; 2], &WallSegment) = (s.particles.position(i), &s.walls[w]);
             [

@@ -58,7 +58,7 @@ fn the_expected_work_of_a_pour_is_its_real_work() {
 
 #[test]
 fn eta_is_the_remaining_work_at_the_rate_so_far() {
-    let w = talus::progress::Work {
+    let w = talus::base::progress::Work {
         samples: vec![(0, 0.0), (100, 100.0), (200, 400.0)],
     };
     assert_eq!(w.at(50), 50.0);

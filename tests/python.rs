@@ -9,7 +9,7 @@ mod common;
 use serde_json::{Value, json};
 use std::path::{Path, PathBuf};
 use std::process::Command;
-use talus::snapshot;
+use talus::io::snapshot;
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("talus-python-{name}-{}", std::process::id()));
@@ -130,7 +130,7 @@ fn the_python_reader_reads_what_the_rust_one_reads() {
     assert_eq!(got["time"].as_f64(), Some(s.meta.time));
     assert_eq!(got["step"].as_u64(), Some(s.meta.step));
     assert_eq!(got["provenance"], json!(s.meta.provenance), "what wrote it");
-    assert_eq!(got["provenance"]["commit"], talus::provenance::COMMIT);
+    assert_eq!(got["provenance"]["commit"], talus::base::provenance::COMMIT);
     let ids: Vec<u64> = (s.u32("particles.id").unwrap().iter())
         .map(|&i| i as u64)
         .collect();

@@ -110,7 +110,7 @@ fn each_copy_of_a_layered_polygon_pile_is_its_run_alone() {
 
 #[test]
 fn copies_survive_a_checkpoint() {
-    let check = |c: &talus::checkpoint::Checkpoint| assert!(c.sim.particles.copy.contains(&1));
+    let check = |c: &talus::io::checkpoint::Checkpoint| assert!(c.sim.particles.copy.contains(&1));
     for path in common::PATHS {
         let test = "copies_survive_a_checkpoint";
         common::assert_resumes_bitwise(path, test, &pour(&["replicas=2"]), 3000, 2000, check);
@@ -122,8 +122,8 @@ fn copies_survive_a_checkpoint() {
     let mut sim = Simulation::new(one).unwrap();
     sim.advance(10).unwrap();
     sim.scene.replicas = 1;
-    talus::checkpoint::write(&sim, None, &path).unwrap();
-    assert!(talus::checkpoint::read(&path, &[]).is_err());
+    talus::io::checkpoint::write(&sim, None, &path).unwrap();
+    assert!(talus::io::checkpoint::read(&path, &[]).is_err());
     std::fs::remove_file(&path).ok();
 }
 

@@ -271,7 +271,7 @@ fn same_state(a: &Simulation, b: &Simulation, what: &str) {
 
 #[test]
 fn a_rod_pile_is_bitwise_the_same_on_any_thread_count_and_skin() {
-    talus::parallel::set_min_parallel(1);
+    talus::base::parallel::set_min_parallel(1);
     let v = pile(None);
     let steps = 20_000;
     let one = run_on(1, &v, steps);

@@ -5,7 +5,7 @@ mod common;
 
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use talus::snapshot::{self, SnapshotError};
+use talus::io::snapshot::{self, SnapshotError};
 
 fn tmp(name: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("talus-snapshots-{name}-{}", std::process::id()));

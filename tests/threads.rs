@@ -151,7 +151,7 @@ fn results_do_not_depend_on_the_polygon_hints() {
 #[test]
 fn results_do_not_depend_on_the_thread_count() {
     // Every stage split over the threads even for these small scenes.
-    talus::parallel::set_min_parallel(1);
+    talus::base::parallel::set_min_parallel(1);
     let packing = common::parse(&serde_json::from_str(&talus::bench::packing_scene(600)).unwrap());
     let scenes = [
         ("disk pour", pour(false, None), 3000),
@@ -187,7 +187,7 @@ fn results_do_not_depend_on_the_memory_order() {
     // order, which is no order in space: against plain steps (memory = id order), the
     // same pours and the packing give bitwise the same states, ids, contacts and springs,
     // also when the advances end between rebuilds, and on several threads.
-    talus::parallel::set_min_parallel(1);
+    talus::base::parallel::set_min_parallel(1);
     let packing = common::parse(&serde_json::from_str(&talus::bench::packing_scene(600)).unwrap());
     // The pours are sorted at many rebuilds; the settled packing, created in rows, at
     // the first advance only.

@@ -3,9 +3,9 @@
 //! (`log.csv`).
 
 use super::AnalyzeError;
-use crate::geometry::tangent;
+use crate::base::geometry::tangent;
+use crate::io::snapshot::{self, Snapshot};
 use crate::shape::{P2, area, world};
-use crate::snapshot::{self, Snapshot};
 use std::path::{Path, PathBuf};
 
 /// One particle of the snapshot.
@@ -220,7 +220,7 @@ pub fn of_snapshot(
         let sweep = sweeps.get(k).copied().unwrap_or(0.0);
         let a = if sweep > 0.0 {
             // A rod: its exact area, and its outline as the corners to draw and bound.
-            let s = crate::spheropolygon::Spheropolygon {
+            let s = crate::shape::spheropolygon::Spheropolygon {
                 core: body.clone(),
                 radius: sweep,
             };

@@ -25,7 +25,7 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum AnalyzeError {
     #[error(transparent)]
-    Snapshot(#[from] crate::snapshot::SnapshotError),
+    Snapshot(#[from] crate::io::snapshot::SnapshotError),
     #[error("{}: no such file or folder", .0.display())]
     NoSuchPath(PathBuf),
     #[error(

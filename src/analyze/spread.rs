@@ -18,7 +18,7 @@
 
 use super::input::Grain;
 use super::stress::{Tensor, Window};
-use crate::rng::Rng;
+use crate::base::rng::Rng;
 
 /// The seed of every bootstrap in an analysis: fixed, so an analysis is reproducible.
 pub const SEED: u64 = 0x7a1e_5eed;

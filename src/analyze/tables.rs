@@ -2,7 +2,7 @@
 //! (docs/FORMATS.md), each file atomically.
 
 use super::{Analysis, AnalyzeError, BASE_SPAN, heap, stress};
-use crate::files::write_atomic;
+use crate::base::files::write_atomic;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

@@ -521,7 +521,7 @@ mod tests {
         // n = 1000: 45 columns, the last of 23 rows partly filled.
         for n in [7, 1000] {
             let scene = crate::scene::parse(&packing_scene(n), &[]).unwrap();
-            let p = crate::create::initial_particles(&scene, &mut crate::rng::Rng::new(1));
+            let p = crate::create::initial_particles(&scene, &mut crate::base::rng::Rng::new(1));
             assert_eq!(p.len(), n);
             let cols = ((2.0 * n as f64).sqrt().ceil() as usize).max(2);
             let h = 3f64.sqrt() / 2.0;

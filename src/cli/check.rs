@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use talus::gpu::device::{self, BackendChoice as Backend};
 use talus::gpu::{GpuError, GpuSimulation};
 use talus::run::Engine;
-use talus::{checkpoint, run, scene, sim::Simulation};
+use talus::{io::checkpoint, run, scene, sim::Simulation};
 
 pub(super) fn cmd_check(
     path: Option<PathBuf>,
@@ -246,13 +246,13 @@ fn time_engine_keep(
     sim: &Simulation,
     b: Backend,
     seconds: f64,
-    work: Option<&talus::progress::Work>,
+    work: Option<&talus::base::progress::Work>,
     settle: bool,
 ) -> Result<(Option<f64>, u64, u64, (String, usize), Simulation), Failure> {
     let total = run::total_steps(sim).max(1);
     let start = checkpoint::Checkpoint::fresh(sim.clone());
     let mut engine = match b {
-        Backend::Gpu => Engine::Gpu(Box::new(GpuSimulation::resume(start)?)),
+        Backend::Gpu => Engine::Gpu(Box::new(GpuSimulation::resume(start.sim, start.device)?)),
         _ => Engine::cpu(start.sim),
     };
     let diverged = |e| Failure::failed(format!("the scene diverged while timed: {e}"));
@@ -312,7 +312,7 @@ fn time_engine(
     sim: &Simulation,
     b: Backend,
     seconds: f64,
-    work: Option<&talus::progress::Work>,
+    work: Option<&talus::base::progress::Work>,
 ) -> Result<(Option<f64>, u64, u64, (String, usize)), Failure> {
     let (rate, from, to, named, _) = time_engine_keep(sim, b, seconds, work, work.is_none())?;
     Ok((rate, from, to, named))

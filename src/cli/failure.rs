@@ -6,8 +6,8 @@
 use std::fmt::Display;
 use talus::analyze::AnalyzeError;
 use talus::bench::BenchError;
-use talus::checkpoint::CheckpointError;
 use talus::gpu::GpuError;
+use talus::io::checkpoint::CheckpointError;
 use talus::render::RenderError;
 use talus::reproduce::ReproductionError;
 use talus::run::RunError;

@@ -7,7 +7,7 @@ use super::{build_simulation, choose_engine, load_scene, measure_and_draw, on_in
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use talus::gpu::device::BackendChoice as Backend;
-use talus::{checkpoint, run};
+use talus::{io::checkpoint, run};
 
 /// What `talus run` was asked.
 #[derive(clap::Args)]

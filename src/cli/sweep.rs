@@ -13,7 +13,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use talus::gpu::device::BackendChoice as Backend;
 use talus::sweep::{self, Plan, RunState, slurm::SlurmOptions};
-use talus::{checkpoint, run, scene, sim::Simulation};
+use talus::{io::checkpoint, run, sim::Simulation};
 
 #[derive(clap::Args)]
 #[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
@@ -231,7 +231,7 @@ fn write_slurm(dir: &Path, plan: &Plan, a: &SweepArgs) -> Result<(), Failure> {
     std::fs::create_dir_all(&logs)
         .map_err(|e| Failure::failed(format!("cannot create {}: {e}", logs.display())))?;
     let path = dir.join("sweep.sbatch");
-    talus::files::write_atomic(&path, text.as_bytes())
+    talus::base::files::write_atomic(&path, text.as_bytes())
         .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
     if !a.submit {
         out!(
@@ -381,7 +381,7 @@ fn say(bar: &ProgressBar, line: String) {
 /// Runs the plan here, `jobs` runs at once, each on threads/jobs cores (at least one),
 /// with a bar over all runs' steps and a line per finished run; a failed run is reported
 /// and the others go on.
-fn run_here(
+pub(super) fn run_here(
     dir: &Path,
     plan: &Plan,
     backend: Backend,
@@ -549,155 +549,4 @@ fn run_here(
         )));
     }
     Ok(())
-}
-
-/// `talus reproduce ID --seeds ...`: how many seeds, runs at once, and the threads.
-pub struct Seeds {
-    pub seeds: String,
-    pub jobs: Option<usize>,
-    pub threads: usize,
-}
-
-/// `talus reproduce ID --seeds A..B`: every variant as a sweep over the seeds in
-/// `ROOT/<variant>/` (continued when run again, replaced when its plan changed), collected
-/// there, and the statistics of all variants in `ROOT/reproduce.json` with their row-1
-/// S_zz profiles in `ROOT/profiles.svg` (seed means with ± one standard deviation).
-pub fn reproduce(
-    id: &str,
-    size: talus::reproduce::Size,
-    only: Option<&str>,
-    seeds: &Seeds,
-    out: Option<PathBuf>,
-    backend: Backend,
-    quiet: bool,
-) -> Result<(), Failure> {
-    use talus::reproduce;
-    let id = id.to_uppercase();
-    let variants = super::reproduce::chosen_variants(&id, size, only)?;
-    let list = sweep::parse_seeds(&seeds.seeds)?;
-    if seeds.jobs == Some(0) {
-        return Err(Failure::input("--jobs: must be at least 1, got 0"));
-    }
-    let root = out.unwrap_or_else(|| PathBuf::from("runs/reproduce").join(&id));
-    let backend_name = backend
-        .to_possible_value()
-        .map_or("auto".into(), |v| v.get_name().to_string());
-    // Every variant planned (and its scenes checked) before any runs.
-    let mut planned = Vec::new();
-    for v in &variants {
-        let within = |e| Failure::from(e).within(format!("{id} {}", v.name));
-        let base = scene::parse(v.scene, &v.overrides).map_err(within)?;
-        let measuring = sweep::Measuring {
-            window: v.window,
-            row: v.row,
-        };
-        let plan = sweep::plan(&base, &list, &[], &backend_name, measuring)
-            .map_err(|e| Failure::from(e).within(format!("{id} {}", v.name)))?;
-        planned.push((v, base, plan));
-    }
-    let mut statistics = Vec::new();
-    let mut failed = Vec::new();
-    let mut bands = Vec::new();
-    for (v, base, plan) in &planned {
-        let dir = root.join(&v.name);
-        // The variant's folder is this reproduction's own: the same plan continues, a
-        // changed one replaces it.
-        sweep::claim(&dir, plan, base, true)?;
-        if !quiet {
-            eprintln!("{id} {}: {} seeds -> {}", v.name, list.len(), dir.display());
-        }
-        let jobs = seeds.jobs.unwrap_or(match backend {
-            Backend::Gpu => 1,
-            _ => seeds.threads,
-        });
-        match run_here(&dir, plan, backend, jobs, seeds.threads, quiet) {
-            Ok(()) => {}
-            Err(f) if f.code == super::failure::INTERRUPTED => return Err(f.within(&id)),
-            Err(f) => {
-                eprintln!("error: {id} {}: {}", v.name, f.message);
-                failed.push(serde_json::json!({ "variant": v.name, "error": f.message }));
-            }
-        }
-        let c = sweep::collect::gather(&dir, plan);
-        sweep::collect::write(&dir, &c)?;
-        let Some(point) = c.points.first() else {
-            continue;
-        };
-        if point.measured == 0 {
-            out!("{id} {}: none of {} seeds measured", v.name, point.runs);
-        } else {
-            let stat = |name: &str| point.stats.iter().find(|s| s.0 == name).map(|s| s.1);
-            let show = |name: &str, unit: &str| {
-                stat(name).map_or(String::new(), |s| {
-                    format!(
-                        "{:.3}{unit} ± {:.3} (se {:.3}, n {})",
-                        s.mean, s.std, s.se, s.n
-                    )
-                })
-            };
-            out!(
-                "{id} {} ({} of {} seeds measured): repose left {}, right {}, mean {} (middle third {}, apex to toe {}, steepest stretch {}); height {} d; packing {}; Z interior {}; S_zz(1) apex {} max {}; base load centre {} side max {} m g, ratio {}, dip above noise {} m g",
-                v.name,
-                point.measured,
-                point.runs,
-                show("repose_left_deg", "°"),
-                show("repose_right_deg", "°"),
-                show("repose_mean_deg", "°"),
-                show("repose_middle_deg", "°"),
-                show("repose_apex_toe_deg", "°"),
-                show("repose_steepest_deg", "°"),
-                show("height_d", ""),
-                show("packing_fraction_lower_half", ""),
-                show("coordination_interior", ""),
-                show("row1_szz_centre", ""),
-                show("row1_szz_max", ""),
-                show("base_load_centre_mg", ""),
-                show("base_load_side_max_mg", ""),
-                show("base_load_centre_over_side_max", ""),
-                show("base_load_dip_excess_mg", "")
-            );
-        }
-        if let Some((_, profile)) = point.profiles.iter().find(|p| p.0 == "szz_row1")
-            && !profile.is_empty()
-        {
-            let line = profile.iter().map(|b| (b.x, b.mean, b.std)).collect();
-            bands.push((format!("{} ({} seeds)", v.name, point.measured), line));
-        }
-        statistics.push(serde_json::json!({
-            "variant": v.name,
-            "folder": dir.display().to_string(),
-            "seeds": list,
-            "measured": point.measured,
-            "statistics": point.stats.iter().map(|(k, s)| (k.clone(), serde_json::json!(s))).collect::<serde_json::Map<_, _>>(),
-            "profiles": point.profiles,
-            "runs": c.runs,
-        }));
-    }
-    if !bands.is_empty() {
-        let path = root.join("profiles.svg");
-        talus::render::plots::write_bands(
-            &path,
-            &format!("{id}: vertical stress in row 1, seed means ± one standard deviation"),
-            talus::render::plots::Axis::new("X - X_apex", "heap widths"),
-            talus::render::plots::Axis::new("S_zz(1) = 2σ_zz / (ρ g h)", "-"),
-            &bands,
-        )?;
-    }
-    let report = serde_json::json!({
-        "id": id,
-        "full": size != reproduce::Size::Reduced,
-        "size": size,
-        "claim": reproduce::claim(&id),
-        "seeds": list,
-        "variants": statistics,
-        "failed": failed,
-    });
-    super::reproduce::finish_reproduction(
-        &id,
-        &root,
-        &report,
-        failed.len(),
-        planned.len(),
-        "had failed runs",
-    )
 }

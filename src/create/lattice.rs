@@ -21,7 +21,7 @@
 //! Polygons use their inscribed circles for the spacing and heights: exact for the
 //! face-to-face lattice of C = 6, 12, …, approximate otherwise.
 
-use crate::rng::Rng;
+use crate::base::rng::Rng;
 use crate::scene::LatticePile;
 use crate::state::NewParticle;
 

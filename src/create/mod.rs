@@ -5,7 +5,7 @@ pub mod lattice;
 pub mod layered;
 pub mod source;
 
-use crate::rng::Rng;
+use crate::base::rng::Rng;
 use crate::scene::{Creation, PolygonSpec, Scene};
 use crate::shape::{self, P2};
 pub use crate::state::NewParticle;
@@ -109,7 +109,8 @@ pub fn initial_particles_by_block(scene: &Scene, rng: &mut Rng) -> (Particles, V
                     let mut sweep = 0.0;
                     if let Some(rod) = &l.rod {
                         // Paper 004's rod: width `diameter`, length `aspect` widths.
-                        let s = crate::spheropolygon::Spheropolygon::rod(rod.aspect, p.diameter);
+                        let s =
+                            crate::shape::spheropolygon::Spheropolygon::rod(rod.aspect, p.diameter);
                         radius = s.circumradius();
                         sweep = s.radius;
                         corners = s.core;

@@ -5,7 +5,7 @@
 //! seed alone: only *when* it is placed depends on the state. The GPU path relies on
 //! this to draw the candidates on the host ahead of time ([`upcoming`]).
 
-use crate::rng::Rng;
+use crate::base::rng::Rng;
 use crate::scene::{PointSource, Size};
 use crate::state::{NewParticle, Particles};
 
@@ -220,7 +220,7 @@ pub fn particle(spec: &PointSource, c: &Drawn, material: u32) -> NewParticle {
     );
     if let Some(rod) = &spec.rod {
         // Paper 004's rod: width the drawn diameter, length `aspect` widths.
-        let s = crate::spheropolygon::Spheropolygon::rod(rod.aspect, c.axes[0]);
+        let s = crate::shape::spheropolygon::Spheropolygon::rod(rod.aspect, c.axes[0]);
         p.radius = s.circumradius();
         p.sweep = s.radius;
         p.corners = s.core;

@@ -19,7 +19,7 @@ pub const MAX_BUCKETS: u64 = 1 << 21;
 /// The bucket of cell (cx, cz) in a grid of `buckets` buckets (twin of `bucket` in
 /// common.wgsl): the cell itself when the grid is dense (nx nz ≤ buckets), else a
 /// spatial hash.
-pub fn bucket(grid: &crate::cell_list::Grid, buckets: u32, cx: u32, cz: u32) -> u32 {
+pub fn bucket(grid: &crate::cpu::cell_list::Grid, buckets: u32, cx: u32, cz: u32) -> u32 {
     if grid.nx > buckets / grid.nz {
         let mut h = cx.wrapping_mul(HASH_X) ^ cz.wrapping_mul(HASH_Z);
         h ^= h >> 16;
@@ -38,7 +38,7 @@ pub fn bucket(grid: &crate::cell_list::Grid, buckets: u32, cx: u32, cz: u32) -> 
 /// memory and rebuild time O(N) whatever the domain's area, and a pour 10⁵ d wide
 /// runs); otherwise every cell (a dense grid, whose neighbouring cells are neighbours in
 /// memory).
-pub fn bucket_count(grid: &crate::cell_list::Grid, n_cap: u32) -> u64 {
+pub fn bucket_count(grid: &crate::cpu::cell_list::Grid, n_cap: u32) -> u64 {
     let cells = grid.nx as u64 * grid.nz as u64;
     let hashed = (2 * n_cap as u64)
         .next_power_of_two()

@@ -68,12 +68,13 @@ fn f(name: &'static str, v: f64) -> (&'static str, Value) {
 /// Every shared WGSL constant by name, with its Rust source. (A function rather than a
 /// `const`: the entries are checked conversions.)
 pub fn shared() -> Vec<(&'static str, Value)> {
-    use crate::spheropolygon as sp;
+    use crate::cpu::springs::MAX_SUB;
+    use crate::overlap::spheropolygon as sp;
     vec![
         // common.wgsl
         u("WG", layout::WG),
         u("MAX_WORKGROUPS", super::MAX_WORKGROUPS),
-        u("WALL_BASE", crate::contacts::WALL_BASE),
+        u("WALL_BASE", crate::cpu::contacts::WALL_BASE),
         u("EMPTY", layout::EMPTY),
         u("LAW_SPRING_DASHPOT", layout::LAW_SPRING_DASHPOT),
         u("LAW_CONTINUOUS", layout::LAW_CONTINUOUS),
@@ -134,7 +135,7 @@ pub fn shared() -> Vec<(&'static str, Value)> {
         u("VERTEX_I", sp::VERTEX_I),
         u("VERTEX_J", sp::VERTEX_J),
         u("VERTICES", sp::VERTICES),
-        u("MAX_SUB", sp::MAX_SUB),
+        u("MAX_SUB", MAX_SUB),
         // laws.wgsl
         u("LAW_ANY", layout::LAW_ANY),
         // prefix_sum.wgsl

@@ -4,7 +4,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::spheropolygon::MAX_SUB;
+use crate::cpu::springs::MAX_SUB;
 use crate::state::GEAR_VALUES;
 
 /// Candidates per particle as the lower id, and as the higher id, of disks and polygons

@@ -38,6 +38,7 @@ pub mod orientation;
 mod params;
 pub mod position;
 mod profile;
+mod readback;
 mod step;
 mod transfer;
 
@@ -51,17 +52,16 @@ use step::{dispatch_args, initial_control};
 pub use transfer::{build_table, corner_starts, from_device, table_lookup, to_device};
 use transfer::{device_corners, device_walls, initial_state, pr_local};
 
-use crate::checkpoint::Checkpoint;
-use crate::contacts::{Pair, WALL_BASE};
+use crate::cpu::contacts::{Pair, WALL_BASE};
+use crate::cpu::forces::ContactForce;
+use crate::cpu::springs::{SpringTable, pair_key};
 use crate::create::{
     self,
     source::{self, SourceState},
 };
-use crate::forces::ContactForce;
 use crate::law::ContactLaw;
 use crate::scene::{Creation, IntegratorKind, Layered, PointSource};
 use crate::sim::{Divergence, Simulation};
-use crate::springs::{SpringTable, pair_key};
 use crate::state::{GEAR_VALUES, Particles};
 use device::{DeviceError, Gpu};
 use kernels::{Kernel, Pipelines};
@@ -88,7 +88,7 @@ pub struct GpuSimulation {
     pub params: Params,
     /// The device's grid: cells of at least the law's range plus the neighbour lists'
     /// skin (positions are anchored to its cells, see `position`).
-    pub grid: crate::cell_list::Grid,
+    pub grid: crate::cpu::cell_list::Grid,
     n_cap: u32,
     origin: [f64; 2],
     /// The corners in the device's corner buffer, in f64 (shapes of downloaded particles).
@@ -172,7 +172,7 @@ pub fn list_capacity(sim: &Simulation) -> u32 {
     let mut area = crate::scene::smallest_particle_area(&sim.scene);
     for i in 0..p.len() {
         let a = if p.is_swept(i) {
-            crate::spheropolygon::Spheropolygon {
+            crate::shape::spheropolygon::Spheropolygon {
                 core: p.shape[i].clone(),
                 radius: p.sweep[i],
             }
@@ -268,20 +268,22 @@ impl GpuSimulation {
 
     /// Uploads the simulation's state to an opened adapter.
     pub fn with_gpu(sim: Simulation, gpu: Gpu) -> Result<Self, GpuError> {
-        Self::resume_with_gpu(Checkpoint::fresh(sim), gpu)
+        Self::resume_with_gpu(sim, None, gpu)
     }
 
-    /// Opens the best adapter and uploads a checkpoint: its exact device state when it
-    /// has one (a GPU run resumes bitwise), else its f64 state.
-    pub fn resume(ckpt: Checkpoint) -> Result<Self, GpuError> {
-        Self::resume_with_gpu(ckpt, Gpu::open()?)
+    /// Opens the best adapter and uploads a simulation resumed from a checkpoint
+    /// (`io::checkpoint::Checkpoint`'s two parts): its exact device state when it has one
+    /// (a GPU run resumes bitwise), else its f64 state.
+    pub fn resume(sim: Simulation, device_state: Option<DeviceState>) -> Result<Self, GpuError> {
+        Self::resume_with_gpu(sim, device_state, Gpu::open()?)
     }
 
-    pub fn resume_with_gpu(ckpt: Checkpoint, gpu: Gpu) -> Result<Self, GpuError> {
-        let Checkpoint {
-            sim,
-            device: device_state,
-        } = ckpt;
+    /// [`GpuSimulation::resume`] on an opened adapter.
+    pub fn resume_with_gpu(
+        sim: Simulation,
+        device_state: Option<DeviceState>,
+        gpu: Gpu,
+    ) -> Result<Self, GpuError> {
         if let Some(reason) = unsupported(&sim) {
             return Err(GpuError::Unsupported(reason));
         }
@@ -440,7 +442,7 @@ impl GpuSimulation {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cell_list::Grid;
+    use crate::cpu::cell_list::Grid;
 
     #[test]
     fn the_largest_scene_is_what_the_bindings_and_one_dispatch_hold() {

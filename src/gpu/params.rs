@@ -162,7 +162,7 @@ fn fill_pairs(
 /// and the contact law.
 pub(super) fn step_params(
     sim: &Simulation,
-    grid: &crate::cell_list::Grid,
+    grid: &crate::cpu::cell_list::Grid,
     n_cap: u32,
     cells: u64,
     n_sources: usize,

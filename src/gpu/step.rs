@@ -44,7 +44,7 @@ pub(super) struct Batch {
     /// The step the device reaches at its end if no lean step pauses.
     pub(super) end: u64,
     /// Its readback's mapping outcome.
-    pub(super) mapped: super::transfer::MapFlag,
+    pub(super) mapped: super::readback::MapFlag,
 }
 
 /// The stages of a rebuild of the neighbour lists, in order: the old lists' springs into

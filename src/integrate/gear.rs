@@ -87,7 +87,7 @@ pub fn correct_one(q: &mut [Dof; GEAR_VALUES], accel: Dof, dt: f64, c: &[f64; GE
 /// Stage: predict every integrated particle (each on its own, on every thread).
 pub fn predict(p: &mut Particles) {
     let (q, active, fixed) = (&mut p.q, &p.active, &p.fixed);
-    crate::parallel::for_each6(q, |i, v| {
+    crate::base::parallel::for_each6(q, |i, v| {
         if active[i] && !fixed[i] {
             predict_in_place(v);
         }
@@ -111,7 +111,7 @@ where
     F: Fn(usize) -> Dof + Sync + Send,
 {
     let (q, active, fixed, mass, inertia) = (&mut p.q, &p.active, &p.fixed, &p.mass, &p.inertia);
-    crate::parallel::for_each6(q, |i, v| {
+    crate::base::parallel::for_each6(q, |i, v| {
         if active[i] && !fixed[i] {
             let a = super::acceleration(force(i), mass[i], inertia[i], gravity);
             correct_in_place(v, a, dt);

@@ -25,7 +25,7 @@ where
 {
     let (active, fixed, mass, inertia) = (&p.active, &p.fixed, &p.mass, &p.inertia);
     let [q0, q1, ..] = &mut p.q;
-    crate::parallel::for_each2(q0, q1, |i, q0, q1| {
+    crate::base::parallel::for_each2(q0, q1, |i, q0, q1| {
         if active[i] && !fixed[i] {
             let a = acceleration(force(i), mass[i], inertia[i], gravity);
             kick_drift_one(q0, q1, a, dt);

@@ -70,7 +70,7 @@ impl ContactOutput {
     /// wall), or f_t on the law's lever, the same on both disks (paper 001 eq. 13; the
     /// normal force of two disks is central).
     pub fn torques(&self, force: [f64; 2], arm_i: [f64; 2], arm_j: Option<[f64; 2]>) -> [f64; 2] {
-        use crate::geometry::cross;
+        use crate::base::geometry::cross;
         if self.lever > 0.0 {
             return [-self.lever * self.f_t, self.lever * self.f_t];
         }

@@ -17,7 +17,7 @@ fn farthest_pair(points: &[P2]) -> (P2, P2) {
     (best.0, best.1)
 }
 use super::{AreaContact, dot, norm, reduced_arm, sub, unit_or_up};
-use crate::geometry::{WallSegment, cross};
+use crate::base::geometry::{WallSegment, cross};
 use crate::shape::{MAX_CORNERS, P2};
 
 // The twins of polygon.wgsl's forms, step for step. A small overlap is built from an

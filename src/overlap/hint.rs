@@ -28,7 +28,7 @@
 
 use super::polygon::{Outline, along, chord_frame};
 use super::{AreaContact, dot, norm, pair_scale, reduced_arm, sub, unit_or_up};
-use crate::geometry::cross;
+use crate::base::geometry::cross;
 use crate::shape::P2;
 
 /// A candidate's hint: nothing known (0), apart by an edge of p or of q (with the

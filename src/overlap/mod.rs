@@ -32,6 +32,7 @@ mod clip;
 mod disk;
 mod hint;
 mod polygon;
+pub mod spheropolygon;
 mod wall;
 
 pub use clip::{END_A_LINE, END_B_LINE, MAX_CLIP, Q_LINE, WALL_LINE};

@@ -35,7 +35,7 @@ use super::hint::{
     Chain, Hint, NO_BOX, Seen, below_floor, hold, rest, separated_by, separating_edge,
 };
 use super::{AreaContact, dot, norm, pair_scale, reduced_arm, sub, unit_or_up};
-use crate::geometry::cross;
+use crate::base::geometry::cross;
 use crate::shape::{MAX_CORNERS, P2};
 
 const MAX: usize = MAX_CORNERS as usize;

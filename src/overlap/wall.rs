@@ -3,7 +3,7 @@
 
 use super::clip::{END_A_LINE, END_B_LINE, WALL_LINE, clip_lines, with_scratch};
 use super::{AreaContact, corner_mean, dot, norm, sub};
-use crate::geometry::WallSegment;
+use crate::base::geometry::WallSegment;
 use crate::shape::P2;
 
 /// Area contact of polygon p (corners relative to its centre) with a wall segment given
@@ -92,7 +92,7 @@ mod tests {
     }
 
     fn world_pw(p: &[P2], ci: P2, w: &WallSegment) -> Option<(AreaContact, P2)> {
-        polygon_wall(&relative(p, ci), &crate::geometry::wall_from(w, ci))
+        polygon_wall(&relative(p, ci), &crate::base::geometry::wall_from(w, ci))
             .map(|g| (g, [ci[0] + g.arm[0], ci[1] + g.arm[1]]))
     }
 

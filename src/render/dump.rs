@@ -12,7 +12,7 @@
 
 use super::RenderError;
 use crate::analyze::Analysis;
-use crate::files::write_atomic;
+use crate::base::files::write_atomic;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 

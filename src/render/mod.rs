@@ -13,7 +13,7 @@ pub mod text;
 pub mod vtk;
 
 use crate::analyze::Analysis;
-use crate::files::write_atomic;
+use crate::base::files::write_atomic;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use tiny_skia::{Color, FillRule, Paint, PathBuilder, Pixmap, Stroke, Transform};

@@ -8,7 +8,7 @@
 use super::RenderError;
 use crate::analyze::Analysis;
 use crate::analyze::janssen::Janssen;
-use crate::files::write_atomic;
+use crate::base::files::write_atomic;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 

@@ -12,7 +12,7 @@
 //! moving particles of each step, insertions at their rates) is divided by the rate at
 //! its size, step range by step range. A scene without sources is timed as it stands.
 
-use crate::progress::Work;
+use crate::base::progress::Work;
 use crate::scene::{Creation, Scene, SceneError};
 use crate::sim::Simulation;
 

@@ -4,7 +4,7 @@
 //! checkpoint go, and the log up to it carries on.
 
 use super::RunError;
-use crate::files::{is_temporary, remove_stale_temporaries};
+use crate::base::files::{is_temporary, remove_stale_temporaries};
 use std::path::Path;
 
 /// What a run writes into its folder. Not `scene.json`: it is written over, and may be

@@ -11,10 +11,10 @@ pub mod outputs;
 
 pub use engine::Engine;
 
-use crate::files::write_atomic;
-use crate::progress::{Progress, Work};
+use crate::base::files::write_atomic;
+use crate::base::progress::{Progress, Work};
+use crate::io::snapshot;
 use crate::sim::{Divergence, Simulation};
-use crate::snapshot;
 use folder::Claimed;
 use outputs::{Outputs, Schedule, Settling};
 use serde::Serialize;
@@ -43,7 +43,7 @@ pub struct RunSummary {
     pub scene: String,
     pub backend: String,
     /// talus's version and commit, the command line and the threads (issue 41).
-    pub provenance: crate::provenance::Provenance,
+    pub provenance: crate::base::provenance::Provenance,
     pub steps: u64,
     pub time: f64,
     /// Active particles at the end, and of them the moving (not fixed) ones.
@@ -234,7 +234,7 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
     let text = serde_json::to_string_pretty(&scene).expect("a scene always serialises");
     write_atomic(&scene_path, text.as_bytes()).map_err(io(&scene_path))?;
 
-    let provenance = crate::provenance::Provenance::here(&engine.name());
+    let provenance = crate::base::provenance::Provenance::here(&engine.name());
     let mut outputs = Outputs::new(&scene, out, start_step, &provenance);
     let mut settling = Settling::new(&scene);
     // Progress between checks as well, so that the engine runs freely in between (on

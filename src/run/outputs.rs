@@ -3,12 +3,12 @@
 //! the settling check, on its own schedule.
 
 use super::{Engine, RunError, io};
-use crate::files::write_atomic;
-use crate::progress::Progress;
-use crate::provenance::Provenance;
+use crate::base::files::write_atomic;
+use crate::base::progress::Progress;
+use crate::base::provenance::Provenance;
 use crate::scene::Scene;
 use crate::sim::Simulation;
-use crate::{analyze, checkpoint, render, snapshot};
+use crate::{analyze, io::checkpoint, io::snapshot, render};
 use std::path::{Path, PathBuf};
 
 /// How many checkpoint files are kept (older ones are deleted).

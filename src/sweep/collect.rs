@@ -9,7 +9,7 @@
 //! run on a cluster collects to the same bytes as the same sweep run locally.
 
 use super::{Failed, Measures, Plan, PlannedRun, RunState, SweepError};
-use crate::files::write_atomic;
+use crate::base::files::write_atomic;
 use crate::render::plots;
 use serde::Serialize;
 use std::fmt::Write as _;

@@ -4,7 +4,7 @@
 use super::{SweepError, io};
 use crate::analyze::Analysis;
 use crate::analyze::heap::Readings;
-use crate::files::write_atomic;
+use crate::base::files::write_atomic;
 use crate::reproduce::{self, Findings};
 use serde::{Deserialize, Serialize};
 use std::path::Path;

@@ -22,7 +22,7 @@ pub mod collect;
 mod measures;
 pub mod slurm;
 
-use crate::files::write_atomic;
+use crate::base::files::write_atomic;
 use crate::scene::{self, Scene, SceneError};
 pub use measures::{Measures, read_measures, write_measures};
 use serde::{Deserialize, Serialize};

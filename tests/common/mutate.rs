@@ -5,7 +5,7 @@
 //! `--set` overrides. Every choice comes from the seeded `Rng`, so a case replays.
 
 use serde_json::{Value, json};
-use talus::rng::Rng;
+use talus::base::rng::Rng;
 
 pub fn below(rng: &mut Rng, n: usize) -> usize {
     (rng.next_u64() % n as u64) as usize

@@ -9,9 +9,9 @@
 //! configuration, number for number, and any difference in its contacts is the code's.
 
 use serde_json::{Value, json};
-use talus::geometry::WallSegment;
+use talus::base::geometry::WallSegment;
+use talus::base::rng::Rng;
 use talus::overlap::{polygon_disk, polygon_polygon};
-use talus::rng::Rng;
 use talus::shape::{P2, circumradius, ellipse_polygon, rotate};
 use talus::sim::Simulation;
 use talus::state::{NewParticle, Particles};

@@ -2,8 +2,8 @@
 //! (issue 42 item 4).
 
 use super::{Path, engine};
-use talus::checkpoint::{self, Checkpoint};
 use talus::gpu::{DeviceState, GpuSimulation};
+use talus::io::checkpoint::{self, Checkpoint};
 use talus::run::Engine;
 use talus::sim::Simulation;
 
@@ -46,7 +46,7 @@ pub fn assert_resumes_bitwise(
         Path::Gpu => {
             let gpu = super::gpu(test).expect("a second device context");
             Engine::Gpu(Box::new(
-                GpuSimulation::resume_with_gpu(loaded, gpu).expect("resumes"),
+                GpuSimulation::resume_with_gpu(loaded.sim, loaded.device, gpu).expect("resumes"),
             ))
         }
     };

@@ -2,13 +2,13 @@
 //! random generator, source progress, step count) plus the scene, bit for bit, so that a
 //! resumed run is bitwise identical to an uninterrupted one (SPEC 3).
 
+use crate::base::files::{Decoder, Encoder, write_atomic};
+use crate::base::rng::Rng;
+use crate::cpu::springs::SpringTable;
 use crate::create::source::SourceState;
-use crate::files::{Decoder, Encoder, write_atomic};
 use crate::gpu::DeviceState;
-use crate::rng::Rng;
 use crate::scene::Scene;
 use crate::sim::Simulation;
-use crate::springs::SpringTable;
 use crate::state::{GEAR_VALUES, Particles};
 use std::path::Path;
 
@@ -34,7 +34,7 @@ pub enum CheckpointError {
     #[error("checkpoint {0} is damaged: its checksum does not match its contents")]
     Checksum(String),
     #[error("checkpoint {0} is damaged: {1}")]
-    Corrupt(String, crate::files::DecodeError),
+    Corrupt(String, crate::base::files::DecodeError),
     #[error("checkpoint {0} holds an invalid scene: {1}")]
     Scene(String, crate::scene::SceneError),
     /// A new stage's scene (`--from`) that cannot continue the state.
@@ -144,7 +144,7 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
 }
 
 fn checksum(bytes: &[u8]) -> u64 {
-    crate::files::fnv1a64(crate::files::FNV_START, bytes)
+    crate::base::files::fnv1a64(crate::base::files::FNV_START, bytes)
 }
 
 /// The tags of the optional sections at a checkpoint's end, in this order: the
@@ -374,12 +374,12 @@ fn decode(
         .iter()
         .any(|&m| m as usize >= scene.materials.len())
     {
-        return Err(corrupt(crate::files::DecodeError(bytes.len())));
+        return Err(corrupt(crate::base::files::DecodeError(bytes.len())));
     }
     for _ in 0..n {
         let count = d.u32().map_err(corrupt)? as usize;
         if count > crate::shape::MAX_CORNERS as usize {
-            return Err(corrupt(crate::files::DecodeError(bytes.len())));
+            return Err(corrupt(crate::base::files::DecodeError(bytes.len())));
         }
         let mut corners = Vec::with_capacity(count);
         for _ in 0..count {
@@ -406,7 +406,7 @@ fn decode(
     }
     let flag = d.u8().map_err(corrupt)?;
     let mut device_state = if flag != 0 {
-        let mut raw = || -> Result<&[u8], crate::files::DecodeError> {
+        let mut raw = || -> Result<&[u8], crate::base::files::DecodeError> {
             let n = d.u64()? as usize;
             d.take(n)
         };
@@ -421,7 +421,7 @@ fn decode(
             // the GPU resume is then not bitwise.
             None
         } else if !sizes_ok {
-            return Err(corrupt(crate::files::DecodeError(bytes.len())));
+            return Err(corrupt(crate::base::files::DecodeError(bytes.len())));
         } else {
             Some(DeviceState {
                 states: bytemuck::pod_collect_to_vec(states),
@@ -433,7 +433,7 @@ fn decode(
     } else {
         None
     };
-    let damaged = || corrupt(crate::files::DecodeError(bytes.len()));
+    let damaged = || corrupt(crate::base::files::DecodeError(bytes.len()));
     let mut tag = if d.is_done() {
         None
     } else {
@@ -449,10 +449,10 @@ fn decode(
         for _ in 0..entries {
             let key = d.u64().map_err(corrupt)?;
             let count = d.u8().map_err(corrupt)? as usize;
-            if count > crate::spheropolygon::MAX_SUB {
+            if count > crate::cpu::springs::MAX_SUB {
                 return Err(damaged());
             }
-            let mut s = crate::spheropolygon::SubSprings {
+            let mut s = crate::cpu::springs::SubSprings {
                 count,
                 ..Default::default()
             };
@@ -488,7 +488,7 @@ fn decode(
         tag = None;
     }
     if tag.is_some() || !d.is_done() || !cap.is_power_of_two() {
-        return Err(corrupt(crate::files::DecodeError(bytes.len())));
+        return Err(corrupt(crate::base::files::DecodeError(bytes.len())));
     }
     let sim = Simulation::from_parts(scene, p, springs, sources, rng, step, lost)
         .map_err(|e| CheckpointError::Scene(name, e))?;

@@ -6,12 +6,12 @@
 //! Pairs of two fixed particles are skipped: neither moves. Polygons are first screened by
 //! their circumscribed circles, then kept when their outlines overlap.
 
-use crate::cell_list::{CellList, Grid};
-use crate::forces::offset;
-use crate::geometry::{WallSegment, disk_disk, disk_wall, wall_from};
+use crate::base::geometry::{WallSegment, disk_disk, disk_wall, wall_from};
+use crate::cpu::cell_list::{CellList, Grid};
+use crate::cpu::orientation::RotatedCorners;
 use crate::overlap::{overlap_area, polygon_disk, polygon_wall};
-use crate::shape::RotatedCorners;
 use crate::state::Particles;
+use crate::state::offset;
 
 /// Ids at and above this refer to walls: `WALL_BASE + wall index`.
 pub const WALL_BASE: u32 = 0xFFFF_0000;

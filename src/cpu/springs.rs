@@ -10,7 +10,7 @@
 //! step can neither be lost nor duplicated. Keys depend only on ids, never on the sorted
 //! order, so springs survive every re-sort.
 
-use crate::contacts::Pair;
+use crate::cpu::contacts::Pair;
 
 const EMPTY: u64 = u64::MAX;
 const MIN_CAPACITY: usize = 64;
@@ -34,7 +34,7 @@ pub struct SpringTable {
     pub values: Vec<f64>,
     /// Spheropolygon pairs (law hertz_cohesive): each pair's sub-contact springs, keyed
     /// by the pair (the sub-contacts inside by their own keys, `SubSprings`).
-    pub sub: std::collections::BTreeMap<u64, crate::spheropolygon::SubSprings>,
+    pub sub: std::collections::BTreeMap<u64, crate::cpu::springs::SubSprings>,
 }
 
 impl Default for SpringTable {
@@ -117,10 +117,43 @@ pub fn store_history(pairs: &[Pair], values: &[f64], table: &mut SpringTable) {
     }
 }
 
+/// Sub-contact springs a pair keeps at most from one step to the next: a rod pair has
+/// at most four sub-contacts (two vertices on each side). Beyond that (polygon cores
+/// touching at many points) the shallowest sub-contacts' springs restart every step.
+pub const MAX_SUB: usize = 4;
+
+/// One pair's tangential springs, each keyed by its sub-contact (`SubContact::key`):
+/// what the neighbour list's slot holds for a spheropolygon pair between steps (SPEC 3:
+/// "keyed by the pair and the sub-contact").
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SubSprings {
+    pub count: usize,
+    pub key: [u32; MAX_SUB],
+    pub xi: [f64; MAX_SUB],
+}
+
+impl SubSprings {
+    /// The spring of a sub-contact, 0 for one that was not there at the last step.
+    pub fn get(&self, key: u32) -> f64 {
+        (0..self.count)
+            .find(|&k| self.key[k] == key)
+            .map_or(0.0, |k| self.xi[k])
+    }
+
+    /// Keeps a sub-contact's spring for the next step (the first `MAX_SUB` only).
+    pub fn push(&mut self, key: u32, xi: f64) {
+        if self.count < MAX_SUB {
+            self.key[self.count] = key;
+            self.xi[self.count] = xi;
+            self.count += 1;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rng::Rng;
+    use crate::base::rng::Rng;
     use std::collections::BTreeMap;
 
     #[test]

@@ -70,7 +70,7 @@ where
     let parts = threads_for(v.len());
     let b = bounds(v.len(), parts, 1);
     let s = shares(v, &b);
-    crate::team::run(parts, &|t| {
+    crate::base::team::run(parts, &|t| {
         for (m, x) in take(&s, t).iter_mut().enumerate() {
             f(b[t] + m, x);
         }
@@ -88,7 +88,7 @@ where
     let parts = threads_for(v.len());
     let b = bounds(v.len(), parts, 1);
     let s = shares(v, &b);
-    crate::team::run(parts, &|t| f(b[t], &mut take(&s, t)));
+    crate::base::team::run(parts, &|t| f(b[t], &mut take(&s, t)));
 }
 
 /// f(k, &mut a[k], &mut b[k]) for every k (a and b of equal length).
@@ -119,7 +119,7 @@ where
     let bd = bounds(a.len(), parts * pieces, block);
     let (sa, sb) = (shares(a, &bd), shares(b, &bd));
     let next: Vec<AtomicUsize> = (0..parts).map(|t| AtomicUsize::new(t * pieces)).collect();
-    crate::team::run(parts, &|t| {
+    crate::base::team::run(parts, &|t| {
         for owner in (0..parts).map(|o| (t + o) % parts) {
             loop {
                 let k = next[owner].fetch_add(1, Ordering::Relaxed);
@@ -178,7 +178,7 @@ where
     let b = bounds(n, parts, 1);
     let q = v.each_mut().map(|q| shares(q, &b));
     let (sw, sx) = (shares(w, &b), shares(x, &b));
-    crate::team::run(parts, &|t| {
+    crate::base::team::run(parts, &|t| {
         let mut g = [0, 1, 2, 3, 4, 5].map(|d| take(&q[d], t));
         let (mut w, mut x) = (take(&sw, t), take(&sx, t));
         let [a, b1, c, d, e, h] = &mut g;
@@ -204,7 +204,7 @@ where
     let parts = threads_for(n);
     let b = bounds(n, parts, 1);
     let hits: Vec<Mutex<Option<usize>>> = (0..parts).map(|_| Mutex::new(None)).collect();
-    crate::team::run(parts, &|t| {
+    crate::base::team::run(parts, &|t| {
         *take_slot(&hits, t) = (b[t]..b[t + 1]).find(|&k| f(k));
     });
     hits.into_iter()
@@ -223,7 +223,7 @@ where
     }
     let b = bounds(n, parts, 1);
     let out: Vec<Mutex<Vec<T>>> = (0..parts).map(|_| Mutex::new(Vec::new())).collect();
-    crate::team::run(parts, &|t| {
+    crate::base::team::run(parts, &|t| {
         *take_slot(&out, t) = (b[t]..b[t + 1]).map(&f).collect();
     });
     let mut all = Vec::with_capacity(n);

@@ -5,7 +5,9 @@
 //! polygon's centroid at the origin; a disk has no corners. The world position of
 //! corner k of particle i is r_i + R(θ_i) v_k. The contact geometry never forms that sum:
 //! it works with the rotated corners R(θ_i) v_k and the offset between the two centres
-//! (src/overlap.rs), so a contact is computed the same anywhere in the domain.
+//! (`crate::overlap`), so a contact is computed the same anywhere in the domain.
+
+pub mod spheropolygon;
 
 /// A point or vector in the plane.
 pub type P2 = [f64; 2];
@@ -103,77 +105,6 @@ pub fn rotate(v: &[P2], theta: f64, out: &mut Vec<P2>) {
     let (s, c) = theta.sin_cos();
     out.clear();
     out.extend(v.iter().map(|p| [c * p[0] - s * p[1], s * p[0] + c * p[1]]));
-}
-
-/// Every polygon's corners turned to its current orientation, relative to its centre,
-/// rebuilt each step after the orientations change (disks have none): particle i's are
-/// `corners[start[i]..start[i + 1]]`, contiguous, computed once per polygon per step and
-/// read by each of its pairs (issue 37 item 4).
-#[derive(Clone, Debug, Default)]
-pub struct RotatedCorners {
-    pub start: Vec<u32>,
-    pub corners: Vec<P2>,
-    /// Which particle each corner belongs to, every body corner in one array, and each
-    /// particle's (sin θ, cos θ): laid out again only when particles were added.
-    owner: Vec<u32>,
-    body: Vec<P2>,
-    turn: Vec<[f64; 2]>,
-}
-
-impl RotatedCorners {
-    pub fn of(&self, i: usize) -> &[P2] {
-        &self.corners[self.start[i] as usize..self.start[i + 1] as usize]
-    }
-
-    /// Polygon i's outline in a frame where its centre lies at `base`; `reach`: its
-    /// circumscribed radius.
-    #[inline]
-    pub fn outline(&self, i: usize, base: P2, reach: f64) -> crate::overlap::Outline<'_> {
-        crate::overlap::Outline {
-            v: self.of(i),
-            base,
-            reach,
-        }
-    }
-}
-
-/// Stage (twin of `rotate_corners` in orientation.wgsl): every polygon's corners at its
-/// current orientation, R(θ) v, on every thread.
-pub fn rotate_corners(particles: &crate::state::Particles, out: &mut RotatedCorners) {
-    if out.start.len() != particles.len() + 1 {
-        // Shapes never change; only new particles add corners.
-        out.start.clear();
-        out.owner.clear();
-        out.body.clear();
-        for (i, shape) in particles.shape.iter().enumerate() {
-            out.start.push(out.body.len() as u32);
-            out.body.extend_from_slice(shape);
-            out.owner.extend(std::iter::repeat_n(i as u32, shape.len()));
-        }
-        out.start.push(out.body.len() as u32);
-        out.corners.resize(out.body.len(), [0.0; 2]);
-    }
-    if out.body.is_empty() {
-        return; // disks only
-    }
-    out.turn.resize(particles.len(), [0.0; 2]);
-    let q = &particles.q[0];
-    let shapes = &particles.shape;
-    crate::parallel::for_each(&mut out.turn, |i, sc| {
-        if !shapes[i].is_empty() {
-            let (s, c) = q[i][2].sin_cos();
-            *sc = [s, c];
-        }
-    });
-    let (owner, body, turn) = (&out.owner, &out.body, &out.turn);
-    crate::parallel::for_each_share(&mut out.corners, |k0, share| {
-        let n = share.len();
-        let from = body[k0..k0 + n].iter().zip(&owner[k0..k0 + n]);
-        for (x, (v, &o)) in share.iter_mut().zip(from) {
-            let [s, c] = turn[o as usize];
-            *x = [c * v[0] - s * v[1], s * v[0] + c * v[1]];
-        }
-    });
 }
 
 #[cfg(test)]

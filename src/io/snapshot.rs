@@ -4,8 +4,8 @@
 //! `read` loads it back. The `.bin` is renamed into place before the `.json`, so
 //! metadata never points at missing data.
 
-use crate::contacts::WALL_BASE;
-use crate::files::write_atomic;
+use crate::base::files::write_atomic;
+use crate::cpu::contacts::WALL_BASE;
 use crate::sim::Simulation;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -46,7 +46,7 @@ pub struct Meta {
     /// What wrote it (since issue 41; absent in older snapshots and in one captured in
     /// memory).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub provenance: Option<crate::provenance::Provenance>,
+    pub provenance: Option<crate::base::provenance::Provenance>,
     /// "fnv1a64:" and 16 hex digits: FNV-1a over the `.bin` and then this metadata
     /// without the checksum, as compact JSON (`digest`). A snapshot in memory has none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -120,7 +120,7 @@ pub fn write_with(
     sim: &Simulation,
     dir: &Path,
     stem: &str,
-    provenance: &crate::provenance::Provenance,
+    provenance: &crate::base::provenance::Provenance,
 ) -> std::io::Result<PathBuf> {
     let mut snap = capture(sim, stem);
     snap.meta.provenance = Some(provenance.clone());
@@ -293,7 +293,7 @@ impl Snapshot {
 /// checksum (compact JSON), so that a changed byte in either file is noticed; whitespace
 /// in the `.json` does not count (it changes no value).
 fn digest(meta: &Meta, bin: &[u8]) -> String {
-    use crate::files::{FNV_START, fnv1a64};
+    use crate::base::files::{FNV_START, fnv1a64};
     let bare = Meta {
         checksum: None,
         ..meta.clone()

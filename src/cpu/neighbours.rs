@@ -28,12 +28,12 @@
 //! in `pairs` follows memory, and no sum depends on it, so results are bitwise the same
 //! in any memory order.
 
-use crate::cell_list::Grid;
-use crate::contacts::{Pair, WALL_BASE};
-use crate::geometry::{WallSegment, disk_wall, wall_from};
+use crate::base::geometry::{WallSegment, disk_wall, wall_from};
+use crate::cpu::cell_list::Grid;
+use crate::cpu::contacts::{Pair, WALL_BASE};
+use crate::cpu::springs::{SpringTable, pair_key};
 use crate::overlap::Hint;
-use crate::springs::{SpringTable, pair_key};
-use crate::state::{Dof, Particles};
+use crate::state::{Dof, Particles, gather};
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// The default skin, as a fraction of the largest diameter.
@@ -54,7 +54,7 @@ pub struct NeighbourList {
     pub history: Vec<f64>,
     /// Spheropolygon scenes (law hertz_cohesive): each candidate's sub-contact springs,
     /// moved with the slots like `history` (empty under the other laws).
-    pub sub_history: Vec<crate::spheropolygon::SubSprings>,
+    pub sub_history: Vec<crate::cpu::springs::SubSprings>,
     /// Each candidate's hint of what its last evaluation found (polygon pairs,
     /// `overlap::Hint`): it decides only how much work the next evaluation takes, never
     /// its result, so it is not part of the state (no checkpoint keeps it). Moved with
@@ -84,7 +84,7 @@ impl NeighbourList {
     /// particle inserted or removed, or one moved by more than skin/2 since the rebuild.
     pub fn needs_rebuild(&self, particles: &Particles) -> bool {
         self.stale(particles)
-            || crate::parallel::position_first(particles.len(), |i| self.moved(particles, i))
+            || crate::base::parallel::position_first(particles.len(), |i| self.moved(particles, i))
                 .is_some()
     }
 
@@ -320,11 +320,6 @@ impl Clone for Hints {
     }
 }
 
-/// `v` in a new order: `out[k] = v[from[k]]`.
-pub fn gather<T: Copy>(v: &[T], from: &[u32]) -> Vec<T> {
-    from.iter().map(|&k| v[k as usize]).collect()
-}
-
 /// A pair of memory slots as the pair of their ids (walls stay as they are).
 #[inline]
 pub fn id_pair(p: Pair, ids: &[u32]) -> Pair {
@@ -364,14 +359,14 @@ fn sort_by_cell(grid: &Grid, particles: &Particles, ids: &[u32], out: &mut Vec<C
     let q = &particles.q[0];
     out.clear();
     out.extend(
-        crate::parallel::map(particles.len(), |i| {
+        crate::base::parallel::map(particles.len(), |i| {
             let (x, z) = grid.cell_coords([q[i][0], q[i][1]]);
             (cell_key(grid, particles.copy[i], x, z), ids[i], i as u32)
         })
         .into_iter()
         .filter(|&(_, _, i)| particles.active[i as usize]),
     );
-    crate::parallel::sort_unstable(out);
+    crate::base::parallel::sort_unstable(out);
 }
 
 /// A particle of the sparse cell list: (cell key, id, memory slot).
@@ -406,7 +401,7 @@ struct Search<'a> {
 /// The candidates of every active particle, in contact order, and where each particle's
 /// start (each particle's found on its own, on every thread).
 fn list_candidates(s: &Search, out: &mut Vec<Pair>, start: &mut Vec<u32>) {
-    let lists = crate::parallel::map(s.particles.len(), |i| {
+    let lists = crate::base::parallel::map(s.particles.len(), |i| {
         let mut v = Vec::new();
         candidates_of(s, i, &mut v);
         v

@@ -12,17 +12,12 @@ macro_rules! out {
         let _ = writeln!(std::io::stdout(), $($t)*);
     }};
 }
-#[path = "cli/analyze.rs"]
 mod analyze;
-#[path = "cli/check.rs"]
 mod check;
-#[path = "cli/failure.rs"]
 mod failure;
-#[path = "cli/reproduce.rs"]
 mod reproduce;
-#[path = "cli/run.rs"]
+#[path = "run.rs"]
 mod run_cmd;
-#[path = "cli/sweep.rs"]
 mod sweep;
 
 use failure::Failure;
@@ -33,12 +28,12 @@ use std::sync::atomic::AtomicBool;
 use talus::gpu::GpuSimulation;
 use talus::gpu::device::{self, BackendChoice as Backend};
 use talus::run::Engine;
-use talus::{bench, checkpoint, scene, sim::Simulation};
+use talus::{bench, io::checkpoint, scene, sim::Simulation};
 
 #[derive(Parser)]
 #[command(
     name = "talus",
-    version = talus::provenance::VERSION_LINE,
+    version = talus::base::provenance::VERSION_LINE,
     about = "2D granular dynamics (DEM) of heaps and packings"
 )]
 struct Cli {
@@ -312,13 +307,13 @@ fn command(command: Command, threads: usize) -> ExitCode {
             backend,
             quiet,
         } => {
-            let seeds = sweep::Seeds {
+            let seeds = reproduce::Seeds {
                 seeds,
                 jobs,
                 threads,
             };
             let size = reproduce::reproduction_size(full, rods);
-            sweep::reproduce(&id, size, only.as_deref(), &seeds, out, backend, quiet)
+            reproduce::reproduce(&id, size, only.as_deref(), &seeds, out, backend, quiet)
         }
         Command::Reproduce {
             id,
@@ -473,7 +468,10 @@ fn choose_engine(
 ) -> Result<Engine, Failure> {
     match backend {
         Backend::Cpu => Ok(Engine::cpu(start.sim)),
-        Backend::Gpu => Ok(Engine::Gpu(Box::new(GpuSimulation::resume(start)?))),
+        Backend::Gpu => Ok(Engine::Gpu(Box::new(GpuSimulation::resume(
+            start.sim,
+            start.device,
+        )?))),
         Backend::Auto => {
             let why = match device::choose_adapter() {
                 Ok(a) if a.get_info().device_type == wgpu::DeviceType::Cpu => format!(
@@ -483,7 +481,7 @@ fn choose_engine(
                 ),
                 Ok(_) => {
                     let fallback = start.sim.clone();
-                    return match GpuSimulation::resume(start) {
+                    return match GpuSimulation::resume(start.sim, start.device) {
                         Ok(g) => Ok(Engine::Gpu(Box::new(g))),
                         Err(e) => {
                             if !quiet {
@@ -523,7 +521,7 @@ fn cmd_agree(
     let text = serde_json::to_string_pretty(&report).expect("report serialises");
     out!("{text}");
     if let Some(path) = out {
-        talus::files::write_atomic(&path, text.as_bytes())
+        talus::base::files::write_atomic(&path, text.as_bytes())
             .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
     }
     let disagree = report.results.iter().filter(|a| !a.passed).count();
@@ -594,14 +592,14 @@ fn cmd_bench(
             // the workloads it finished); a write that fails is reported at the end.
             if let Some(path) = &out {
                 let text = serde_json::to_string_pretty(so_far).expect("report serialises");
-                let _ = talus::files::write_atomic(path, text.as_bytes());
+                let _ = talus::base::files::write_atomic(path, text.as_bytes());
             }
         },
     )?;
     let text = serde_json::to_string_pretty(&report).expect("report serialises");
     out!("{text}");
     if let Some(path) = out {
-        talus::files::write_atomic(&path, text.as_bytes())
+        talus::base::files::write_atomic(&path, text.as_bytes())
             .map_err(|e| Failure::failed(format!("cannot write {}: {e}", path.display())))?;
     }
     if !report.failures.is_empty() {

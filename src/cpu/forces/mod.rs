@@ -1,0 +1,139 @@
+//! Per-contact forces and their per-particle reduction.
+//!
+//! `contact_forces` evaluates each contact on its own (geometry → relative velocity →
+//! law) and stores the force on particle i and the contact point. `reduce_forces` then
+//! sums, for every particle, its contacts in contact-list order. On the CPU that is one
+//! pass over the list adding +F to i and −F to j; it visits each particle's contacts in
+//! increasing contact index, the same fixed order a per-particle GPU reduction uses, so
+//! the sum never depends on thread timing (no float atomics).
+
+use crate::base::geometry::{Geometry, WallSegment, tangent};
+use crate::cpu::contacts::Pair;
+use crate::cpu::orientation::RotatedCorners;
+use crate::law::{ContactInput, ContactLaw, ContactOutput};
+use crate::state::{Dof, Particles, offset};
+
+mod candidates;
+mod divergence;
+mod kinematics;
+mod reduce;
+mod rods;
+
+pub use candidates::{
+    CandidateResults, Kick, candidate_force, candidate_force_hinted, candidate_forces,
+};
+pub use divergence::{diverges, overlap_ratio};
+pub use kinematics::{area_contact, area_contact_hinted, contact_input};
+pub use reduce::{kick_sum, reduce_candidate_forces, reduce_forces};
+
+/// The result of one contact, kept for outputs and the reduction.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactForce {
+    /// Total force on particle i (−force acts on j).
+    pub force: [f64; 2],
+    /// Its torques: about i's centre, arm × F, and about j's, (arm + r_i − r_j) × F (the
+    /// torque on j is minus that; 0 for a wall).
+    pub torque: [f64; 2],
+    /// Contact point, where both forces act (world coordinates, for outputs).
+    pub point: [f64; 2],
+    /// The contact point relative to particle i's centre: the branch vector the torques
+    /// use (relative to j's centre it is `arm + r_i − r_j`).
+    pub arm: [f64; 2],
+    /// Normal (from j to i) and the normal and tangential components.
+    pub n: [f64; 2],
+    pub f_n: f64,
+    pub f_t: f64,
+    /// Geometric overlap δ.
+    pub overlap: f64,
+    /// Elastic energy stored in the contact.
+    pub energy: f64,
+}
+
+/// What every contact of a step reads: the state, each particle's velocity (q1/dt,
+/// computed once per step, `velocities`), the rotated corners and the walls.
+#[derive(Clone, Copy)]
+pub struct StepState<'a> {
+    pub particles: &'a Particles,
+    pub velocity: &'a [Dof],
+    pub corners: &'a RotatedCorners,
+    pub walls: &'a [WallSegment],
+    pub dt: f64,
+    /// The side of the material form's pair table (src/law/restitution.rs); 0 without.
+    pub pair_side: usize,
+}
+
+/// Stage: the velocity (vx, vz, ω) = q1/dt of every particle.
+pub fn velocities(particles: &Particles, dt: f64, out: &mut Vec<Dof>) {
+    out.resize(particles.len(), [0.0; 3]);
+    crate::base::parallel::for_each(out, |i, v| *v = particles.velocity(i, dt));
+}
+
+/// Stage: forces of every contact, and the updated tangential history.
+#[allow(clippy::too_many_arguments)]
+pub fn contact_forces(
+    particles: &Particles,
+    corners: &RotatedCorners,
+    walls: &[WallSegment],
+    law: &ContactLaw,
+    dt: f64,
+    pairs: &[Pair],
+    history_in: &[f64],
+    out: &mut Vec<ContactForce>,
+    history_out: &mut Vec<f64>,
+) {
+    let mut velocity = Vec::new();
+    velocities(particles, dt, &mut velocity);
+    let s = StepState {
+        particles,
+        velocity: &velocity,
+        corners,
+        walls,
+        dt,
+        pair_side: law.pair_table().map_or(0, |t| t.side),
+    };
+    out.clear();
+    history_out.clear();
+    let area = matches!(law, ContactLaw::OverlapArea(_));
+    for (&pair, &history) in pairs.iter().zip(history_in) {
+        let (g, input) = contact_input(&s, area, pair, history);
+        let (c, h) = contact_force(particles, |c| law.evaluate(c), pair, &g, &input);
+        out.push(c);
+        history_out.push(h);
+    }
+}
+
+/// The law applied to one contact's geometry and kinematics: the force on i and the
+/// updated history.
+#[inline(always)]
+pub(super) fn contact_force(
+    particles: &Particles,
+    evaluate: impl Fn(&ContactInput) -> ContactOutput,
+    pair: Pair,
+    g: &Geometry,
+    input: &ContactInput,
+) -> (ContactForce, f64) {
+    let res = evaluate(input);
+    let t = tangent(g.n);
+    let force = [
+        res.f_n * g.n[0] + res.f_t * t[0],
+        res.f_n * g.n[1] + res.f_t * t[1],
+    ];
+    let i = pair.i as usize;
+    let p = particles.position(i);
+    let arm_j = (!pair.is_wall()).then(|| {
+        let d = offset(particles, i, pair.j as usize);
+        [g.arm[0] + d[0], g.arm[1] + d[1]]
+    });
+    let c = ContactForce {
+        force,
+        torque: res.torques(force, g.arm, arm_j),
+        point: [p[0] + g.arm[0], p[1] + g.arm[1]],
+        arm: g.arm,
+        n: g.n,
+        f_n: res.f_n,
+        f_t: res.f_t,
+        overlap: g.delta,
+        energy: res.energy,
+    };
+    (c, res.history)
+}
