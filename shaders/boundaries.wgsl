@@ -1,4 +1,4 @@
-// Stage: boundaries (src/sim.rs `remove_escaped`): a particle whose centre left the
+// Stage: boundaries (src/sim/insert.rs `remove_escaped`): a particle whose centre left the
 // domain is deactivated and counted as lost. Also the divergence check on positions,
 // and the step counter that closes every step. `leave_domain` runs at the end of the
 // integrators' kernels (`correct`, `kick_drift`), for each active particle once it has

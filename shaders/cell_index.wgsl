@@ -1,4 +1,4 @@
-// Stages 1 and 2 of the counting sort (src/cell_list.rs `cell_index`, `cell_histogram`):
+// Stages 1 and 2 of the counting sort (src/cpu/cell_list.rs `cell_index`, `cell_histogram`):
 // the cell of each active particle, counted in its cell at once (integer atomics: the
 // counts do not depend on the order of the additions; one dispatch less per rebuild).
 // The anchor *is* the cell, clamped into the grid. `clear_cells` clears the counters
@@ -37,6 +37,6 @@ fn cell_index(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     let c = bucket(cell_coords(state[i].anchor));
     cell_of[i] = c;
-    // The histogram (src/cell_list.rs `cell_histogram`).
+    // The histogram (src/cpu/cell_list.rs `cell_histogram`).
     atomicAdd(&cell_count[c], 1u);
 }

@@ -27,7 +27,7 @@ const C_LOST: u32 = 2u;
 const C_HALT: u32 = 3u;
 const C_HALT_STEP: u32 = 4u;
 const C_HALT_ID: u32 = 5u;
-// Bits of the neighbour lists' word (src/neighbours.rs; issue 13).
+// Bits of the neighbour lists' word (src/cpu/neighbours.rs; issue 13).
 const C_LISTS: u32 = 6u;
 // How many times the lists were built.
 const C_REBUILDS: u32 = 7u;
@@ -161,7 +161,7 @@ struct State {
     frac: vec2<u32>,
     turn: u32,
     // Where the particle was when the lists were built: its anchor (two i16 in one word)
-    // and frac (src/neighbours.rs `moved`; the survey kernel).
+    // and frac (src/cpu/neighbours.rs `moved`; the survey kernel).
     listed_anchor: u32,
     listed_frac: vec2<u32>,
     // q1's whole units: position units along x and z, turn units of the rotation
@@ -200,7 +200,7 @@ struct Entry {
     _pad: u32,
 };
 
-// A spheropolygon pair's tangential springs, one per sub-contact (src/spheropolygon.rs
+// A spheropolygon pair's tangential springs, one per sub-contact (src/cpu/springs.rs
 // `SubSprings`; MAX_SUB = 4): the sub-contact's key (`SubContact::key`, EMPTY for none)
 // and its spring. Per candidate slot (`sub_hist`) and per entry of the spring table
 // (`table_sub`, beside `table`).

@@ -1,5 +1,5 @@
-// Stage (src/forces.rs `candidate_forces`): each candidate of the lists on its own:
-// whether it touches (`touches`: the test of src/forces.rs `candidate_force`), and if it
+// Stage (src/cpu/forces/candidates.rs `candidate_forces`): each candidate of the lists on its own:
+// whether it touches (`touches`: the test of src/cpu/forces/candidates.rs `candidate_force`), and if it
 // does, its geometry, the relative velocity at the contact point and the law. Stores
 // the force on i, both torques, the normal and contact point it used, and the updated
 // history in the candidate's slot; a candidate that does not touch gets zero force and
@@ -103,7 +103,7 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
         mass = 2.0 * m12;
     }
     // The law sees the rate of delta: the overlap's for disks, L v_n / l for the
-    // overlap area (delta = A/l; src/forces.rs `area_contact_input`).
+    // overlap area (delta = A/l; src/cpu/forces/kinematics.rs `area_kinematics`).
     var rate = 1.0;
     var touches = false;
     if (POLYGONS) {
@@ -161,7 +161,7 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
                              v_centres, v1.z + v2.z);
     let res = evaluate(input);
     let f = res.f_n * g.n + res.f_t * t;
-    // Paper 001 eq. 13 (src/forces.rs `contact_force`): both torques on the law's lever.
+    // Paper 001 eq. 13 (src/cpu/forces/mod.rs `contact_force`): both torques on the law's lever.
     var torques = vec2<f32>(cross2(l1, f), -cross2(l2, f));
     if (res.lever > 0.0) { torques = vec2<f32>(-res.lever * res.f_t); }
     contact_ft[slot] = vec4<f32>(f, torques);

@@ -2,7 +2,7 @@
 // velocity-dependent forces (Allen & Tildesley). Each particle's contact forces are summed
 // here as it is corrected (`acceleration`, reduce_forces.wgsl).
 
-// Whether to predict the particle for the next step once corrected (src/sim.rs
+// Whether to predict the particle for the next step once corrected (src/sim/mod.rs
 // `correct_ahead`; `Kernel::CorrectAhead`): the host asks for it when another step
 // follows on the device at once, with no insertion before its prediction.
 override AHEAD: bool = false;
@@ -43,7 +43,7 @@ fn correct(@builtin(global_invocation_id) gid: vec3<u32>) {
         renormalize(&s);
         renormalize_turn(&s);
     }
-    // The boundaries (boundaries.wgsl; src/sim.rs `remove_escaped`).
+    // The boundaries (boundaries.wgsl; src/sim/insert.rs `remove_escaped`).
     leave_domain(i, s);
     // The next step's prediction and survey (predict.wgsl `predict_particle`): one
     // dispatch and one pass over the state less per step. A particle the boundaries

@@ -1,4 +1,4 @@
-// Stage (src/neighbours.rs `list_candidates`; at a rebuild of the lists only): for
+// Stage (src/cpu/neighbours.rs `list_candidates`; at a rebuild of the lists only): for
 // particle i, every j of a higher id in the 3x3 cells around it whose circles come
 // within the skin of the law's range, sorted by id, then its walls. Each candidate is also entered
 // in j's `down` list (slot index i * list_cap + k), which the reduction needs; that

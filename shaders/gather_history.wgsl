@@ -1,4 +1,4 @@
-// Stage (src/neighbours.rs `carry_over`; at a rebuild of the lists only): each new
+// Stage (src/cpu/neighbours.rs `carry_over`; at a rebuild of the lists only): each new
 // candidate's tangential history from the spring table, where the rebuild has just
 // stored the old lists' springs (store_history); a missing key is a pair that was not in
 // contact (0).
@@ -22,7 +22,7 @@ fn find_entry(i: u32, j: u32) -> u32 {
 
 // Particle p's down list (its candidates as the higher id) sorted by the id of the lower
 // particle: the order in which `kick_sum` adds them at every step until the next rebuild
-// (src/neighbours.rs `down_lists` builds them in that order; find_contacts appends them
+// (src/cpu/neighbours.rs `down_lists` builds them in that order; find_contacts appends them
 // in whatever order its threads arrive). Sorted in place, once per rebuild.
 fn sort_down_list(p: u32) {
     let nd = min(atomicLoad(&down_count[p]), params.list_cap);

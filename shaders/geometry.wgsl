@@ -1,4 +1,4 @@
-// Contact geometry of disks and walls (src/geometry.rs), from fixed-point offsets
+// Contact geometry of disks and walls (src/base/geometry.rs), from fixed-point offsets
 // (position.wgsl): the overlap comes out as a whole number of units plus a small f32
 // part, so it keeps its relative precision however small it is.
 

@@ -21,6 +21,6 @@ fn kick_drift(@builtin(global_invocation_id) gid: vec3<u32>) {
         state[i] = s;
         rotate_corners(i, s);
     }
-    // The boundaries (boundaries.wgsl; src/sim.rs `remove_escaped`).
+    // The boundaries (boundaries.wgsl; src/sim/insert.rs `remove_escaped`).
     leave_domain(i, s);
 }

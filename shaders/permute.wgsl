@@ -1,4 +1,4 @@
-// Stage (src/sim.rs `Simulation::permute`, issue 13 item 4; at a rebuild of the lists
+// Stage (src/sim/order.rs `Simulation::permute`, issue 13 item 4; at a rebuild of the lists
 // only, after the cell list): the particles sorted in memory by cell, so that a
 // particle's neighbours lie near it in memory. `sorted` holds the new order (the active
 // particles by cell from `scatter`, then the inactive ones from `cell_index`); the

@@ -1,6 +1,6 @@
 // Stage: whether this step's rebuild stages run (issue 14 item 2). After the prediction
 // and its survey, the neighbour lists' word says whether the lists are rebuilt this step
-// (src/sim.rs `step`: the survey, an insertion, a removal). The rebuild stages (the old
+// (src/sim/mod.rs `step`: the survey, an insertion, a removal). The rebuild stages (the old
 // lists' springs into the table, the cell list, the memory order, the new lists and
 // their springs) are dispatched indirectly with the arguments written here: their
 // workgroup counts at a rebuild, none between rebuilds or after a halt. A step between

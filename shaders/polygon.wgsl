@@ -24,7 +24,7 @@
 // other laws compile without the polygon branches, which would otherwise cost every
 // disk contact registers.
 override POLYGONS: bool = false;
-// Corners of a polygon at most (src/shape.rs). The cut keeps a bit per edge and two per
+// Corners of a polygon at most (src/shape/mod.rs). The cut keeps a bit per edge and two per
 // crossing in a u32 and an edge's number in four bits: at most 16.
 const MAX_CORNERS: u32 = 16u;
 // Which shapes the scene has, now or from its sources (src/gpu/kernels.rs `Build`), and
@@ -563,7 +563,7 @@ fn polygon_polygon(p: ptr<function, Outline>, q: ptr<function, Outline>, h: vec2
     let q_sum = select(in_q.sum, chain_sum, chained);
     if (n_p + n_q + n_x < 3u) { return no_contact(); }
     let scale = length(cj - ci) + (*p).reach;
-    // The two crossings farthest apart (src/overlap.rs `farthest_pair`).
+    // The two crossings farthest apart (src/overlap/disk.rs `farthest_pair`).
     var best = -1.0;
     var xa = vec2<f32>(0.0);
     var xb = vec2<f32>(0.0);
@@ -858,7 +858,7 @@ fn polygon_wall_iw(i: u32, w: u32) -> AreaContact {
     return g;
 }
 
-// ---- Disks under the overlap-area law (mixed scenes; src/overlap.rs) ----
+// ---- Disks under the overlap-area law (mixed scenes; src/overlap/) ----
 //
 // The CPU path computes these areas in f64 by general formulas (triangles in a circle,
 // lens, segment). In f32 those cancel badly for a small overlap, so here each area is
@@ -889,7 +889,7 @@ fn segment_area(r: f32, e: f32) -> f32 {
     return 0.5 * r * r * x_minus_sin(4.0 * a);
 }
 
-// The lens of two disks (src/overlap.rs `disk_disk_area`), in length units with the
+// The lens of two disks (src/overlap/disk.rs `disk_disk_area`), in length units with the
 // force point relative to centre i. The overlap delta is exact (geometry.wgsl); the
 // sagittas of the two segments are delta (r_j + d - r_i) / 2d and delta (r_i + d - r_j) / 2d.
 fn disks_area_ij(i: u32, j: u32) -> AreaContact {
@@ -918,7 +918,7 @@ fn disks_area_ij(i: u32, j: u32) -> AreaContact {
     return c;
 }
 
-// A disk and a wall (src/overlap.rs `disk_wall_area`): the segment beyond the wall's
+// A disk and a wall (src/overlap/disk.rs `disk_wall_area`): the segment beyond the wall's
 // line, of the exact depth of geometry.wgsl's `disk_wall`, scaled by the part of its
 // chord that lies over the wall (an approximation at the wall's ends, as on the CPU).
 fn disk_wall_area(i: u32, w: u32) -> AreaContact {
@@ -955,7 +955,7 @@ fn disk_wall_area(i: u32, w: u32) -> AreaContact {
 }
 
 // Signed area of the triangle (0, a, b) inside the circle of radius r about the origin
-// (src/overlap.rs `triangle_in_circle`): the fallback for deep polygon-disk overlaps.
+// (src/overlap/disk.rs `triangle_in_circle`): the fallback for deep polygon-disk overlaps.
 fn triangle_in_circle(a: vec2<f32>, b: vec2<f32>, r: f32) -> f32 {
     let d = b - a;
     let qa = dot(d, d);
@@ -1097,7 +1097,7 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
     if (!done && inside > 0u && cut_any == 0u) {
         // A run of corners inside (one or more in a row), no other edge cut: the polygon
         // from the crossing into the run, along it, to the crossing out of it, plus the
-        // minor segment beyond their chord (src/overlap.rs `corner_cap`). The crossings
+        // minor segment beyond their chord (src/overlap/disk.rs `corner_cap`). The crossings
         // come from the end corners' exact depths, the polygon's area from integer
         // offsets about the first crossing; unless the corners inside are not in a row
         // or the disk's centre lies beyond the chord (a major segment): the general
@@ -1146,7 +1146,7 @@ fn polygon_disk_ij(poly: u32, disk: u32, polygon_is_i: bool) -> AreaContact {
         }
     }
     if (!done) {
-        // Deep or unusual: the general formula in f32 (src/overlap.rs `polygon_disk`),
+        // Deep or unusual: the general formula in f32 (src/overlap/disk.rs `polygon_disk`),
         // the force point between the two crossings of the outlines farthest apart. The
         // crossings are found again for each pair of edges rather than listed (a
         // per-thread list is local memory on a GPU), in the CPU's order: by edge, then

@@ -33,7 +33,7 @@ fn predict_one(s: ptr<function, State>) {
 }
 
 // Particle i predicted, then surveyed (`bit`: see `survey_one`). `correct` with AHEAD
-// runs the same steps for the next step on its own copy of the state (src/sim.rs
+// runs the same steps for the next step on its own copy of the state (src/sim/mod.rs
 // `correct_ahead`).
 fn predict_particle(i: u32, bit: u32) {
     var s = state[i];
@@ -45,7 +45,7 @@ fn predict_particle(i: u32, bit: u32) {
         // Forces are evaluated at the predicted state.
         rotate_corners(i, s);
     }
-    // The survey of the predicted particle (survey.wgsl; src/sim.rs `survey_with`), on
+    // The survey of the predicted particle (survey.wgsl; src/sim/mod.rs `survey_with`), on
     // the copy just written.
     survey_one_at(i, bit, s);
 }

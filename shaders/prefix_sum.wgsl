@@ -1,4 +1,4 @@
-// Stage 3 (src/cell_list.rs `prefix_sum`): exclusive prefix sum of the cell counts, in
+// Stage 3 (src/cpu/cell_list.rs `prefix_sum`): exclusive prefix sum of the cell counts, in
 // three levels of 256-element workgroup scans (up to 256^3 cells). Level 0 scans the
 // counts into cell_start and writes each block's total to scan[0..]; level 1 scans those
 // totals in place and writes its block totals at scan[scan_offset2..]; level 2 scans
@@ -79,7 +79,7 @@ fn scan_add1(@builtin(global_invocation_id) gid: vec3<u32>) {
 }
 
 // Also clears each cell's count, read for the last time by scan_level0: `scatter` counts
-// again from 0 as its cursor (src/cell_list.rs `scatter`; one dispatch less per rebuild).
+// again from 0 as its cursor (src/cpu/cell_list.rs `scatter`; one dispatch less per rebuild).
 @compute @workgroup_size(SCAN_WG)
 fn scan_add0(@builtin(global_invocation_id) gid: vec3<u32>) {
     let c = gid.x;

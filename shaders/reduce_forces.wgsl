@@ -1,4 +1,4 @@
-// Stage (src/forces.rs `reduce_candidate_forces`, `kick_sum`): each particle sums its own
+// Stage (src/cpu/forces/reduce.rs `reduce_candidate_forces`, `kick_sum`): each particle sums its own
 // contacts' forces in a fixed order, with no float atomics: first the contacts where it
 // is the higher id (sorted by the lower id, as they come in the CPU's contact list,
 // whatever the memory order), then its own. The integrators' kernels (`correct`,

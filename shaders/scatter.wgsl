@@ -1,4 +1,4 @@
-// Stage 4 (src/cell_list.rs `scatter`): particle ids into cell order. The slot within a
+// Stage 4 (src/cpu/cell_list.rs `scatter`): particle ids into cell order. The slot within a
 // cell comes from an atomic counter, so the order *within* a cell varies from run to
 // run; nothing downstream depends on it, because find_contacts sorts each particle's
 // contacts by partner id. The counts, read for the last time by scan_level0 and cleared

@@ -1,6 +1,6 @@
-// Spheropolygons under paper 004's law (SPEC 2.4; src/spheropolygon.rs `sub_contacts`
-// and `pair_force`, src/forces.rs `spheropolygon_candidate`): a pair's contact is a set
-// of vertex-edge sub-contacts of the cores, each with overlap
+// Spheropolygons under paper 004's law (SPEC 2.4; src/overlap/spheropolygon.rs
+// `sub_contacts`, src/cpu/forces/rods.rs `pair_force` and `spheropolygon_candidate`): a
+// pair's contact is a set of vertex-edge sub-contacts of the cores, each with overlap
 // delta = r_i + r_j - distance(vertex, edge) and its own tangential spring, keyed by
 // the sub-contact (`SubSprings`). The GPU path takes cores of one corner (a disk: a
 // point swept by its radius) or two (a rod's segment), so a pair has at most four
@@ -249,7 +249,7 @@ fn pair_subs(i: u32, j: u32, o: Offset, gap: f32) -> Subs {
     let p = load_core(i, vec2<i32>(0), vec2<f32>(0.0));
     let q = load_core(j, -o.d, -o.e);
     if (p.n == 1u && q.n == 1u) {
-        // Two disks: the one pair of vertices (src/spheropolygon.rs `vertices`).
+        // Two disks: the one pair of vertices (src/overlap/spheropolygon.rs `vertices`).
         let s = vertex_edge(p.a, q.a, q.a, p.r_units + q.r_units, p.r_rem + q.r_rem, gap,
                             p.centre);
         add_sub(&subs, s, VERTICES, false, f32(p.r_units) + p.r_rem,
@@ -304,7 +304,7 @@ fn wall_subs(i: u32, w: u32, gap: f32) -> Subs {
     return subs;
 }
 
-// The force of spheropolygon candidate `slot` of particle i (src/forces.rs
+// The force of spheropolygon candidate `slot` of particle i (src/cpu/forces/rods.rs
 // `spheropolygon_candidate`): every sub-contact under the law with its own spring from
 // the slot's `sub_hist`, summed into the candidate's force and torques. In the outputs
 // the pair has the deepest sub-contact's normal and overlap, at the centre of its
@@ -361,7 +361,7 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
     var energy = 0.0;
     var deepest = 0u;
     // The reported point: the arm l of least-squares F ⊗ l = Σ_k f_k ⊗ l_k, l = (Fᵀ M)/|F|²
-    // with M = Σ_k f_k ⊗ l_k (src/forces.rs `centre_of_forces`): M's columns by l's x, y.
+    // with M = Σ_k f_k ⊗ l_k (src/cpu/forces/rods.rs `centre_of_forces`): M's columns by l's x, y.
     var moment_x = vec2<f32>(0.0);
     var moment_y = vec2<f32>(0.0);
     var sizes = 0.0;

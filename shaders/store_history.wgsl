@@ -1,4 +1,4 @@
-// Stage (src/neighbours.rs `table`; at a rebuild of the lists only, before the new lists
+// Stage (src/cpu/neighbours.rs `table`; at a rebuild of the lists only, before the new lists
 // are built): a fresh table holding the springs of the old lists' candidates that touch.
 // A contact that closed is simply not carried over: no deletion, no tombstones. After an
 // upload the table already holds the springs (TABLE_CURRENT) and is kept; the host may

@@ -1,4 +1,4 @@
-// Stage (src/sim.rs `survey`, src/neighbours.rs `moved`): after the prediction, whether
+// Stage (src/sim/mod.rs `survey`, src/cpu/neighbours.rs `moved`): after the prediction, whether
 // a particle has moved by more than skin/2 since the lists were built; then this step
 // rebuilds them. The displacement comes from the fixed-point position (whole cells and
 // units), so the decision is the same on every run. Insertions and removals ask for a
@@ -26,7 +26,7 @@ fn survey_one(i: u32, bit: u32) {
 
 // `survey_one` for particle i at state s (the caller's copy, as it stores it); also
 // halts the run when its step q1 = v dt is longer than the bound (issue 16: a grain
-// faster than that tunnels through fixed rows; src/sim.rs `SurveyWatch::survey_one`).
+// faster than that tunnels through fixed rows; src/sim/divergence.rs `SurveyWatch::survey_one`).
 fn survey_one_at(i: u32, bit: u32, s: State) {
     if (params.max_step2 > 0.0 && is_active(i)) {
         let step = q1_total(s.q1_whole, s.q[1]).xy;

@@ -1,15 +1,19 @@
-//! talus: 2D granular dynamics (DEM) of disks: a GPU path (WGSL kernels on wgpu, `gpu`)
-//! and a CPU reference path in f64 that it is tested against.
+//! talus: 2D granular dynamics (DEM) of disks, convex polygons and rods: a GPU path
+//! (WGSL kernels on wgpu, `gpu`) and a CPU reference path in f64 (`cpu`, `sim`) that it
+//! is tested against.
 //!
-//! The step is a sequence of stages (see ARCHITECTURE.md): predict → cell list
-//! (`cell_index`, `cell_histogram`, `prefix_sum`, `scatter`) → `find_contacts` →
-//! `gather_history` → `contact_forces` → `store_history` → `reduce_forces` → correct →
-//! boundaries on the GPU; the CPU path finds the same contacts among the candidates of
-//! its neighbour lists (`cpu::neighbours`) and runs on every core (`base::parallel`). Scenes are
-//! JSON files (`scene`), runs are driven by `run`.
+//! The modules are layers, lowest first (ARCHITECTURE.md, "Modules"; held by
+//! tests/architecture.rs `LAYERS`, each naming only those before it): `base` (vectors,
+//! rng, files, threads) → `shape` → `law` → `overlap` (contact geometry) → `state` (the
+//! particles) → `integrate` → `scene` → `cpu` (the CPU path's stages) → `create` → `sim`
+//! (one step, in stage order) → `gpu` → `io` (snapshot and checkpoint formats) →
+//! `analyze` → `render` → `reproduce` → `run` (the run loop) → `sweep` → `bench`.
+//!
+//! The step is a sequence of stages: predict → cell list → neighbour list → contact
+//! forces → reduce → correct → boundaries, each a function on the CPU path with a WGSL
+//! kernel of the same name on the GPU path. Scenes are JSON files (`scene`), runs are
+//! driven by `run`; the command line (clap) lives in the binary (`src/cli/`).
 
-// The layers, lowest first (ARCHITECTURE.md): each depends only on those above it in
-// this list, except for the import cycles tests/architecture.rs still lists (issue 42).
 pub mod analyze;
 pub mod base;
 pub mod bench;

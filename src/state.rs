@@ -28,7 +28,7 @@ pub struct Particles {
     /// Polygon corners in the body frame (counter-clockwise, centroid at the origin);
     /// empty for a disk. `radius` is then the circumscribed radius.
     pub shape: Vec<Vec<P2>>,
-    /// A spheropolygon's sweep radius (src/spheropolygon.rs: `shape` is then its core,
+    /// A spheropolygon's sweep radius (src/shape/spheropolygon.rs: `shape` is then its core,
     /// two corners for a rod); 0 for disks and polygons.
     pub sweep: Vec<f64>,
     /// The copy of the scene a particle belongs to (`replicas`; 0 without copies): it

@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 
 use talus::gpu::constants::{Value, shared};
-use talus::gpu::kernels::MODULES;
+use talus::gpu::modules::MODULES;
 
 /// Module-scope WGSL constants with no Rust twin, each with the reason. None at present:
 /// every `const` of the shaders mirrors a Rust value. A new WGSL-only constant goes here

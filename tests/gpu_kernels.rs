@@ -11,9 +11,9 @@ use talus::cpu::cell_list::{CellList, Grid, prefix_sum};
 use talus::cpu::contacts::{Pair, find_contacts};
 use talus::cpu::forces::{contact_forces, reduce_forces};
 use talus::cpu::orientation::{RotatedCorners, rotate_corners};
-use talus::gpu::kernels::Kernel;
 use talus::gpu::layout::control::REBUILD;
 use talus::gpu::layout::{Entry, MAX_CONTACTS};
+use talus::gpu::modules::Kernel;
 use talus::gpu::{GpuSimulation, REBUILD_STAGES, workgroups};
 
 /// `n` disks of diameter 0.8–1.2 on a jittered lattice in a box with walls, some

@@ -1,8 +1,8 @@
 //! The WGSL kernels compile (naga parse + validation), and the Rust twins of the shared
 //! structs have the sizes and field offsets naga computes for the WGSL. Needs no GPU.
 
-use talus::gpu::kernels::MODULES;
 use talus::gpu::layout;
+use talus::gpu::modules::MODULES;
 
 fn parse(name: &str, src: &str) -> naga::Module {
     let module = naga::front::wgsl::parse_str(src)
@@ -22,7 +22,7 @@ fn every_kernel_module_validates() {
         parse(m.name, &m.source());
     }
     // Every entry point the host dispatches exists in its module.
-    for k in talus::gpu::kernels::Kernel::ALL {
+    for k in talus::gpu::modules::Kernel::ALL {
         let (module, entry) = k.entry();
         let src = MODULES.iter().find(|m| m.name == module).unwrap().source();
         let parsed = parse(module, &src);
@@ -139,7 +139,7 @@ fn bindings_are_declared_only_from_the_rust_list() {
 fn each_kernel_binds_read_only_what_it_never_writes() {
     use talus::gpu::BINDINGS;
     use talus::gpu::bindings::kernel_modules;
-    use talus::gpu::kernels::Kernel;
+    use talus::gpu::modules::Kernel;
     let access = |k: Kernel, name: &str| {
         let km = &kernel_modules()[&k];
         let i = BINDINGS.iter().position(|b| b.name == name).unwrap();

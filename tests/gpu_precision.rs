@@ -19,7 +19,7 @@ use serde_json::json;
 use std::collections::BTreeMap;
 use talus::cpu::forces::area_contact;
 use talus::gpu::GpuSimulation;
-use talus::gpu::kernels::Kernel;
+use talus::gpu::modules::Kernel;
 use talus::sim::Simulation;
 
 const K_N: f64 = 1e7;

@@ -81,7 +81,7 @@ fn seeds() -> Vec<(String, Value)> {
     out
 }
 
-/// What `talus check` does (src/cli.rs `build_simulation`): parse with overrides, the
+/// What `talus check` does (src/cli/mod.rs `build_simulation`): parse with overrides, the
 /// warnings, the initial state. An accepted scene must also come back from the JSON a
 /// run writes (scene.json, and the copy inside every checkpoint that a resume parses),
 /// and take its first steps.

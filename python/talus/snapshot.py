@@ -19,7 +19,7 @@ class SnapshotError(ValueError):
 
 
 def fnv1a64(h, data):
-    """FNV-1a (64 bits) over `data`, continuing from `h` (src/files.rs `fnv1a64`)."""
+    """FNV-1a (64 bits) over `data`, continuing from `h` (src/base/files.rs `fnv1a64`)."""
     for b in data:
         h = ((h ^ b) * FNV_PRIME) & MASK
     return h

@@ -3,8 +3,8 @@
 //! units of the deposit's width W. A deposit whose side walls carry part of its weight
 //! saturates at σ_m below a depth of a few h_s.
 
-use super::heap::Outline;
 use super::input::Grain;
+use super::outline::Outline;
 use super::stress::Tensor;
 use serde::Serialize;
 

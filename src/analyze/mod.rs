@@ -10,6 +10,7 @@ pub mod heap;
 pub mod input;
 pub mod janssen;
 pub mod network;
+pub mod outline;
 pub mod spread;
 pub mod stress;
 pub mod structure;
@@ -136,7 +137,7 @@ pub struct Summary {
     pub g: f64,
     /// ρ g h / 2: the stress unit of S.
     pub stress_scale: f64,
-    pub outline: heap::Outline,
+    pub outline: outline::Outline,
     pub repose_left: heap::Slope,
     pub repose_right: heap::Slope,
     /// The angle of each flank read three more ways (`heap::Readings`).
@@ -253,7 +254,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
         .sum::<f64>()
         / grains.len() as f64;
     let density = total_mass / total_area;
-    let o = heap::trimmed(grains, d);
+    let o = outline::trimmed(grains, d);
     let scale = 0.5 * density * input.g * o.height;
     let moments = stress::moments(grains, &input.touches);
     let windows = stress::moving_averages(

@@ -5,8 +5,8 @@
 //! length; the dimensionless S = 2σ/(ρ g h) then needs ρ as mass per area, which cancels
 //! the thickness.
 
-use super::heap::Outline;
 use super::input::{Grain, Touch};
+use super::outline::Outline;
 
 /// A 2×2 tensor [[xx, xz], [zx, zz]].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

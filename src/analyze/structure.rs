@@ -2,8 +2,8 @@
 //! distribution f(θ) and the orientation correlation Q(r) = ⟨cos 2(θ_i − θ_j)⟩ at
 //! distance r (SPEC 5, paper 004 sec. 3).
 
-use super::heap::Outline;
 use super::input::Grain;
+use super::outline::Outline;
 
 /// One horizontal layer: its middle height, depth below the top, the width it spans
 /// (inside a margin from the outermost grains) and the packing fraction there.

@@ -1,6 +1,6 @@
 //! Contact geometry of disks and walls: normal, overlap, contact point (SPEC 2.1).
 //!
-//! Pure functions, one per pair of shapes (polygons: src/overlap.rs), in a frame at the
+//! Pure functions, one per pair of shapes (polygons: src/overlap/), in a frame at the
 //! first particle's centre: positions enter only as offsets (issue 18).
 
 /// A fixed wall: the segment from `a` to `b`.

@@ -31,7 +31,7 @@ pub(super) fn cmd_check(
     let lines = match &sim.law {
         talus::law::ContactLaw::SpringDashpot(l) => {
             let masses = scene::typical_masses(&sim.scene);
-            talus::law::restitution::describe(l, &names, &masses)
+            l.describe(&names, &masses)
         }
         talus::law::ContactLaw::OverlapArea(l) => l.describe(&names),
         _ => Vec::new(),
@@ -369,7 +369,7 @@ fn what_creators_add(sim: &Simulation) -> Vec<String> {
         total += s.count as u64 * copies;
     }
     for (k, l) in layered.iter().enumerate() {
-        let rows = talus::create::layered::max_rows(l);
+        let rows = talus::scene::rows::max_rows(l);
         let most: u64 = (0..rows)
             .map(|r| talus::create::layered::row_capacity(l, r) as u64)
             .sum();

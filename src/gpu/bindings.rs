@@ -14,7 +14,7 @@
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
-use super::kernels::{Kernel, MODULES};
+use super::modules::{Kernel, MODULES, ModuleSource};
 
 /// A WGSL variable's binding.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -239,4 +239,18 @@ pub fn kernel_groups(k: Kernel) -> [Option<GroupShape>; 3] {
             .collect();
         (!entries.is_empty()).then_some((g, entries))
     })
+}
+
+impl ModuleSource {
+    /// The module's WGSL: its files and its bindings, every storage buffer
+    /// `read_write` (each kernel is compiled from it reduced to its entry point, with
+    /// what that does not write made `read`: `bindings::kernel_modules`).
+    pub fn source(&self) -> String {
+        self.source_with(|_| true)
+    }
+
+    /// The module with the bindings `writable` says declared `read_write`.
+    pub fn source_with(&self, writable: impl Fn(&Binding) -> bool) -> String {
+        self.parts.join("\n") + &declarations(self.name, writable)
+    }
 }

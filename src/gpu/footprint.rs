@@ -98,7 +98,7 @@ pub fn footprint(sim: &Simulation) -> Footprint {
         if let Some(spec) = point_sources.get(k) {
             to_come += spec.count.saturating_sub(st.inserted) as u64;
         } else if let Some(spec) = layered_specs.get(k - point_sources.len()) {
-            layered += (st.inserted..create::layered::max_rows(spec))
+            layered += (st.inserted..crate::scene::rows::max_rows(spec))
                 .map(|row| create::layered::row_capacity(spec, row) as u64)
                 .sum::<u64>();
         }

@@ -29,7 +29,7 @@ impl GpuSimulation {
             .iter()
             .filter_map(|b| {
                 let k = self.sim.sources[b.index].inserted;
-                if k >= create::layered::max_rows(&b.spec) {
+                if k >= crate::scene::rows::max_rows(&b.spec) {
                     return None;
                 }
                 let due = b.spec.start_time + k as f64 * b.spec.interval;
@@ -216,7 +216,7 @@ pub(super) fn upcoming(
         for (m, spec) in layered_specs.iter().enumerate() {
             let index = copy as usize * per_copy + specs.len() + m;
             let corners = spec.polygon.as_ref().map_or(0, |p| p.corners as usize);
-            for k in sim.sources[index].inserted..create::layered::max_rows(spec) {
+            for k in sim.sources[index].inserted..crate::scene::rows::max_rows(spec) {
                 let n = create::layered::row_capacity(spec, k);
                 layered_count += n as u32;
                 layered_corners += n * corners;

@@ -34,6 +34,7 @@ pub mod device;
 mod insert;
 pub mod kernels;
 pub mod layout;
+pub mod modules;
 pub mod orientation;
 mod params;
 pub mod position;
@@ -64,8 +65,9 @@ use crate::scene::{Creation, IntegratorKind, Layered, PointSource};
 use crate::sim::{Divergence, Simulation};
 use crate::state::{GEAR_VALUES, Particles};
 use device::{DeviceError, Gpu};
-use kernels::{Kernel, Pipelines};
+use kernels::Pipelines;
 use layout::*;
+use modules::Kernel;
 use wgpu::util::DeviceExt;
 
 /// Workgroups of one dispatch at most (per dimension; the GPU path dispatches in one).

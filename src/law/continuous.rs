@@ -4,12 +4,10 @@
 //! Lengths enter through σ = (d1 + d2)/2 and forces through m g with m = 2 m12, so the
 //! law is the paper's reduced-unit law for any units and for unequal disks.
 
+use super::spec::{ContinuousSpec, HookeEquivalentSpec, ParamError, RollingArm, TangentialDamping};
 use super::spring_dashpot::{non_negative, positive};
 use super::tangential::{tapered_energy, tapered_friction, tapered_stiffness};
 use super::{ContactInput, ContactOutput, clamp_non_negative};
-use crate::scene::{
-    ContinuousSpec, HookeEquivalentSpec, RollingArm, SceneError, TangentialDamping,
-};
 
 /// The elastic part of the normal force.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -45,10 +43,10 @@ pub struct Reading {
 }
 
 impl Continuous {
-    pub fn from_spec(s: &ContinuousSpec, g: f64) -> Result<Self, SceneError> {
+    pub fn from_spec(s: &ContinuousSpec, g: f64) -> Result<Self, ParamError> {
         positive("contact.n", s.n)?;
         if !(s.r0 > 1.0 && s.r0.is_finite()) {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 "contact.r0",
                 format!("must be greater than 1 (in units of σ), got {}", s.r0),
             ));
@@ -70,10 +68,10 @@ impl Continuous {
         })
     }
 
-    pub fn from_hooke_spec(s: &HookeEquivalentSpec, g: f64) -> Result<Self, SceneError> {
+    pub fn from_hooke_spec(s: &HookeEquivalentSpec, g: f64) -> Result<Self, ParamError> {
         positive("contact.n", s.n)?;
         if !(s.r0 > 1.0 && s.r0.is_finite()) {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 "contact.r0",
                 format!("must be greater than 1, got {}", s.r0),
             ));
@@ -82,7 +80,7 @@ impl Continuous {
             Some(k) => positive("contact.k", k)?,
             None => {
                 if !(s.r_i > 0.0 && s.r_i < 1.0) {
-                    return Err(SceneError::invalid(
+                    return Err(ParamError::invalid(
                         "contact.r_i",
                         format!("must be in (0, 1) (units of σ), got {}", s.r_i),
                     ));
@@ -241,18 +239,18 @@ pub fn equivalent_hooke_constant(n: f64, r0: f64, r_i: f64) -> f64 {
     2.0 * (r_i.powf(-n) - r0.powf(-n)) / n / ((1.0 - r_i) * (1.0 - r_i))
 }
 
-fn force_scale(given: Option<f64>, gravity: f64) -> Result<f64, SceneError> {
+fn force_scale(given: Option<f64>, gravity: f64) -> Result<f64, ParamError> {
     match given {
         Some(g) => positive("contact.g", g),
         None if gravity > 0.0 => Ok(gravity),
-        None => Err(SceneError::invalid(
+        None => Err(ParamError::invalid(
             "contact.g",
             "is required when gravity is zero (it sets the force scale m g)",
         )),
     }
 }
 
-fn check_friction(mu: f64, alpha: f64, damping: f64) -> Result<(), SceneError> {
+fn check_friction(mu: f64, alpha: f64, damping: f64) -> Result<(), ParamError> {
     non_negative("contact.mu", mu)?;
     positive("contact.alpha", alpha)?;
     non_negative("contact.damping_fraction", damping)?;

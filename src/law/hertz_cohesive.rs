@@ -63,10 +63,10 @@ impl HertzCohesive {
 
     /// The scene's `contact` block; g = |gravity|.
     pub fn from_spec(
-        s: &crate::scene::HertzCohesiveSpec,
+        s: &crate::law::spec::HertzCohesiveSpec,
         g: f64,
-    ) -> Result<Self, crate::scene::SceneError> {
-        use crate::scene::SceneError;
+    ) -> Result<Self, crate::law::spec::ParamError> {
+        use super::spec::ParamError;
         let check = |key: &str, v: f64, positive: bool| {
             if !v.is_finite() || v < 0.0 || (positive && v == 0.0) {
                 let what = if positive {
@@ -74,7 +74,7 @@ impl HertzCohesive {
                 } else {
                     "a non-negative"
                 };
-                return Err(SceneError::invalid(
+                return Err(ParamError::invalid(
                     format!("contact.{key}"),
                     format!("must be {what} number, got {v}"),
                 ));

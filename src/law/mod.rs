@@ -10,10 +10,11 @@ pub mod continuous;
 pub mod hertz_cohesive;
 pub mod overlap_area;
 pub mod restitution;
+pub mod spec;
 pub mod spring_dashpot;
 pub mod tangential;
 
-use crate::scene::{ContactSpec, SceneError};
+use spec::{ContactSpec, ParamError};
 
 /// What the force stage knows about one contact before applying a law.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -127,7 +128,7 @@ pub enum ContactLaw {
     OverlapArea(overlap_area::OverlapArea),
     Continuous(continuous::Continuous),
     /// Spheropolygons (rods, and disks as point cores): paper 004's law per sub-contact
-    /// (src/spheropolygon.rs).
+    /// (src/shape/spheropolygon.rs).
     HertzCohesive(hertz_cohesive::HertzCohesive),
 }
 
@@ -142,7 +143,7 @@ impl ContactLaw {
         g: f64,
         materials: &[String],
         corners: &[u32],
-    ) -> Result<Self, SceneError> {
+    ) -> Result<Self, ParamError> {
         match spec {
             ContactSpec::SpringDashpot(s) => Ok(Self::SpringDashpot(
                 spring_dashpot::SpringDashpot::from_spec(s, materials)?,
@@ -160,27 +161,6 @@ impl ContactLaw {
                 hertz_cohesive::HertzCohesive::from_spec(s, g)?,
             )),
         }
-    }
-
-    /// The contact law of a scene.
-    pub fn of_scene(scene: &crate::scene::Scene) -> Result<Self, SceneError> {
-        let g = scene.gravity.g;
-        let materials: Vec<String> = scene.materials.keys().cloned().collect();
-        // Each material's corner count: its first polygon block's (0 for disks).
-        let corners: Vec<u32> = (materials.iter())
-            .map(|m| {
-                (scene.particles.iter())
-                    .filter(|c| crate::scene::material_of(c) == m)
-                    .find_map(|c| crate::scene::polygon_of(c).map(|p| p.corners))
-                    .unwrap_or(0)
-            })
-            .collect();
-        Self::from_spec(
-            &scene.contact,
-            (g[0] * g[0] + g[1] * g[1]).sqrt(),
-            &materials,
-            &corners,
-        )
     }
 
     /// The material form's pair table, if the law has one.

@@ -1,6 +1,6 @@
 //! The overlap-area law of convex polygons, paper 000 eq. 6–7 and sec. 2.2.2 (SPEC 2.3).
 //!
-//! The geometry (src/overlap.rs) gives the overlap area A, the reduced arm l and the
+//! The geometry (src/overlap/) gives the overlap area A, the reduced arm l and the
 //! chord L. The force stage passes δ = A/l (the length that plays the role of the disk
 //! overlap) and its rate d(A/l)/dt ≈ L v_n / l: for a relative translation the overlap
 //! area changes at exactly L v_n (v_n the approach speed across the chord), and the
@@ -8,9 +8,9 @@
 //! A/l keep the damping at the predicted state, where Gear evaluates every force.
 
 use super::restitution::{PairTable, PerMass};
+use super::spec::{OverlapAreaSpec, ParamError, ResolvedPair};
 use super::tangential::{coulomb_spring, spring_energy};
 use super::{ContactInput, ContactOutput, clamp_non_negative};
-use crate::scene::{OverlapAreaSpec, ResolvedPair, SceneError};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct OverlapArea {
@@ -59,7 +59,7 @@ impl OverlapArea {
         s: &OverlapAreaSpec,
         materials: &[String],
         corners: &[u32],
-    ) -> Result<Self, SceneError> {
+    ) -> Result<Self, ParamError> {
         use super::spring_dashpot::{non_negative, positive};
         non_negative("contact.mu", s.mu)?;
         non_negative("contact.kt_ratio", s.kt_ratio)?;
@@ -68,13 +68,13 @@ impl OverlapArea {
             return Self::from_material_form(s, materials, corners);
         }
         if !s.pairs.is_empty() {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 "contact.pairs",
                 "belongs to the material form: give restitution and contact_time instead of k_n",
             ));
         }
         let Some(k_n) = s.k_n else {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 "contact.k_n",
                 "is required (or give restitution and contact_time, the material form)",
             ));
@@ -102,7 +102,7 @@ impl OverlapArea {
         s: &OverlapAreaSpec,
         materials: &[String],
         corners: &[u32],
-    ) -> Result<Self, SceneError> {
+    ) -> Result<Self, ParamError> {
         let (e, t_c) = super::restitution::given_pair(s.restitution, s.contact_time)?;
         super::restitution::refuse(
             &[("k_n", s.k_n.is_some()), ("eta_n", s.eta_n != 0.0)],

@@ -21,7 +21,7 @@
 //!   the surfaces overlap, t_c = (φ + sin φ)/ω: what the head-on test measures, and π/ω
 //!   again as η → 0. Under the clamp e > e^(−2) ≈ 0.135 (η → ∞).
 
-use crate::scene::SceneError;
+use super::spec::ParamError;
 use std::f64::consts::PI;
 
 /// φ(η) = ω t*, the phase at which the clamped law's force vanishes.
@@ -193,15 +193,15 @@ pub fn collision_power(
 }
 
 /// The first of `keys` given, as the error `contact.KEY: reason`.
-pub fn refuse(keys: &[(&str, bool)], reason: &str) -> Result<(), SceneError> {
+pub fn refuse(keys: &[(&str, bool)], reason: &str) -> Result<(), ParamError> {
     match keys.iter().find(|(_, given)| *given) {
-        Some((key, _)) => Err(SceneError::invalid(format!("contact.{key}"), reason)),
+        Some((key, _)) => Err(ParamError::invalid(format!("contact.{key}"), reason)),
         None => Ok(()),
     }
 }
 
 /// The material form's (e, t_c), both required once either is given.
-pub fn given_pair(e: Option<f64>, t_c: Option<f64>) -> Result<(f64, f64), SceneError> {
+pub fn given_pair(e: Option<f64>, t_c: Option<f64>) -> Result<(f64, f64), ParamError> {
     match (e, t_c) {
         (Some(e), Some(t_c)) => Ok((e, t_c)),
         (None, _) => Err(missing("restitution")),
@@ -209,8 +209,8 @@ pub fn given_pair(e: Option<f64>, t_c: Option<f64>) -> Result<(f64, f64), SceneE
     }
 }
 
-fn missing(key: &str) -> SceneError {
-    SceneError::invalid(
+fn missing(key: &str) -> ParamError {
+    ParamError::invalid(
         format!("contact.{key}"),
         "is required with the other of restitution and contact_time (the material form)",
     )
@@ -234,7 +234,7 @@ pub struct MaterialForm<'a> {
     pub restitution: f64,
     pub contact_time: f64,
     pub mu: f64,
-    pub pairs: &'a [crate::scene::MaterialPair],
+    pub pairs: &'a [crate::law::spec::MaterialPair],
 }
 
 /// The pair table of a material form: `resolve(at, e, t_c, μ, a, b)` gives the
@@ -243,11 +243,11 @@ pub struct MaterialForm<'a> {
 pub fn pair_table(
     form: &MaterialForm,
     materials: &[String],
-    resolve: impl Fn(&str, f64, f64, f64, usize, usize) -> Result<PerMass, SceneError>,
-) -> Result<PairTable, SceneError> {
-    use crate::scene::WALLS;
+    resolve: impl Fn(&str, f64, f64, f64, usize, usize) -> Result<PerMass, ParamError>,
+) -> Result<PairTable, ParamError> {
+    use super::spec::WALLS;
     if !form.pairs.is_empty() && materials.iter().any(|m| m == WALLS) {
-        return Err(SceneError::invalid(
+        return Err(ParamError::invalid(
             format!("materials.{WALLS}"),
             format!("\"{WALLS}\" names the wall segments in contact.pairs: rename the material"),
         ));
@@ -257,12 +257,12 @@ pub fn pair_table(
     let mut own = std::collections::BTreeMap::new();
     for (k, p) in form.pairs.iter().enumerate() {
         let at = format!("contact.pairs[{k}]");
-        let index = |name: &str| -> Result<usize, SceneError> {
+        let index = |name: &str| -> Result<usize, ParamError> {
             if name == WALLS {
                 return Ok(side - 1);
             }
             materials.iter().position(|m| m == name).ok_or_else(|| {
-                SceneError::invalid(
+                ParamError::invalid(
                     format!("{at}.materials"),
                     format!(
                         "unknown material \"{name}\" (known: {}, and \"{WALLS}\")",
@@ -273,13 +273,13 @@ pub fn pair_table(
         };
         let (a, b) = (index(&p.materials[0])?, index(&p.materials[1])?);
         if a == side - 1 && b == side - 1 {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 format!("{at}.materials"),
                 "walls do not touch walls",
             ));
         }
         if own.insert((a.min(b), a.max(b)), k).is_some() {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 format!("{at}.materials"),
                 "this pair is listed twice",
             ));
@@ -317,9 +317,9 @@ pub fn pair_table(
 }
 
 /// (κ, c) of [`per_mass`] or the key's error: e out of reach, t_c not positive.
-pub fn resolve_linear(at: &str, e: f64, t_c: f64, clamp: bool) -> Result<(f64, f64), SceneError> {
+pub fn resolve_linear(at: &str, e: f64, t_c: f64, clamp: bool) -> Result<(f64, f64), ParamError> {
     if !(t_c.is_finite() && t_c > 0.0) {
-        return Err(SceneError::invalid(
+        return Err(ParamError::invalid(
             format!("{at}.contact_time"),
             format!("must be positive, got {t_c}"),
         ));
@@ -333,7 +333,7 @@ pub fn resolve_linear(at: &str, e: f64, t_c: f64, clamp: bool) -> Result<(f64, f
         } else {
             "in (0, 1]".to_string()
         };
-        SceneError::invalid(
+        ParamError::invalid(
             format!("{at}.restitution"),
             format!("must be {range}, got {e}"),
         )
@@ -347,12 +347,12 @@ pub fn resolved(
     materials: &[String],
     collide: impl Fn(usize, usize, &PerMass) -> Option<(f64, f64)>,
     eta: bool,
-) -> Vec<crate::scene::ResolvedPair> {
+) -> Vec<crate::law::spec::ResolvedPair> {
     let name = |k: usize| {
         materials
             .get(k)
             .cloned()
-            .unwrap_or_else(|| crate::scene::WALLS.to_string())
+            .unwrap_or_else(|| crate::law::spec::WALLS.to_string())
     };
     let mut out = Vec::new();
     for a in 0..table.side - 1 {
@@ -364,7 +364,7 @@ pub fn resolved(
             } else {
                 (Some((c.gamma_n, c.gamma_t)), None)
             };
-            out.push(crate::scene::ResolvedPair {
+            out.push(crate::law::spec::ResolvedPair {
                 materials: [name(a), name(b)],
                 restitution: e,
                 contact_time: t_c,
@@ -417,99 +417,6 @@ pub fn effective_mass(mi: f64, fixed_i: bool, j: Option<(f64, bool)>) -> f64 {
         Some((mj, false)) if fixed_i => mj,
         Some((mj, _)) => mi * mj / (mi + mj),
     }
-}
-
-/// `talus check`'s table of the spring-dashpot law per pair of materials: the
-/// coefficients, and the restitution and contact time they give, for typical particles
-/// (`masses`, by material: `scene::typical_masses`) colliding with a moving one and with
-/// a fixed one or a wall (infinitely heavy).
-pub fn describe(
-    law: &super::spring_dashpot::SpringDashpot,
-    materials: &[String],
-    masses: &[Option<f64>],
-) -> Vec<String> {
-    let clamp = if law.clamp {
-        "clamped f_n ≥ 0"
-    } else {
-        "unclamped"
-    };
-    let mut out = Vec::new();
-    let linear = law.nu == 1.0 && law.psi == 0.0;
-    match &law.pairs {
-        Some(_) => out.push(format!(
-            "contact: material form ({clamp}{}): every contact has k = m_eff · k/m of its pair, m_eff its reduced mass (a fixed partner or a wall infinitely heavy)",
-            match law.impact_speed {
-                Some(v) => format!(", ν = {}, ψ = {}: e and t_c at the impact speed {v}", law.nu, law.psi),
-                None => String::new(),
-            }
-        )),
-        None if linear => out.push(format!(
-            "contact: stiffness form ({clamp}): k_n = {}, γ_n = {}, k_t = {}, γ_t = {}, μ = {}; what they give:",
-            law.k_n, law.gamma_n, law.k_t, law.gamma_t, law.mu
-        )),
-        None => {
-            out.push(format!(
-                "contact: nonlinear spring-dashpot (ν = {}, ψ = {}): restitution and contact time depend on the impact speed, not tabulated",
-                law.nu, law.psi
-            ));
-            return out;
-        }
-    }
-    let side = materials.len() + 1;
-    let name = |k: usize| materials.get(k).map_or(crate::scene::WALLS, |s| s.as_str());
-    // One line per pair and per kind of partner: (m_eff, what it is).
-    let collide = |kappa: f64, c: f64| match collision(kappa, c, law.clamp) {
-        Some((e, t_c)) => format!("e {e:.3}, t_c {t_c:.3e}"),
-        None => "no bounce (overdamped)".to_string(),
-    };
-    for a in 0..materials.len() {
-        let Some(ma) = masses[a] else { continue };
-        for b in a..side {
-            let partners: Vec<(f64, String)> = if b == side - 1 {
-                vec![(ma, "a wall".to_string())]
-            } else {
-                let Some(mb) = masses[b] else { continue };
-                vec![
-                    (ma * mb / (ma + mb), "two moving".to_string()),
-                    (ma, format!("a moving {} on a fixed {}", name(a), name(b))),
-                ]
-            };
-            let pair = format!("  {}–{}:", name(a), name(b));
-            match &law.pairs {
-                Some(t) => {
-                    let p = t.coeffs[a * t.side + b];
-                    let bounce = match law.collision(&p) {
-                        Some((e, t_c)) => format!("e {e:.3}, t_c {t_c:.3e}"),
-                        None => "no bounce (overdamped)".to_string(),
-                    };
-                    let mut line = format!(
-                        "{pair} {bounce}, μ {}; per unit mass k_n {:.4e}, γ_n {:.4e}, k_t {:.4e}, γ_t {:.4e}",
-                        p.mu, p.k_n, p.gamma_n, p.k_t, p.gamma_t
-                    );
-                    for (m, what) in partners {
-                        line += &format!(
-                            "; {what} (m_eff {m:.4}): k_n {:.4e}, γ_n {:.4e}",
-                            p.k_n * m,
-                            p.gamma_n * m
-                        );
-                    }
-                    out.push(line);
-                }
-                None => {
-                    let parts: Vec<String> = (partners.iter())
-                        .map(|(m, what)| {
-                            format!(
-                                "{what} (m_eff {m:.4}): {}",
-                                collide(law.k_n / m, law.gamma_n / m)
-                            )
-                        })
-                        .collect();
-                    out.push(format!("{pair} {}", parts.join("; ")));
-                }
-            }
-        }
-    }
-    out
 }
 
 #[cfg(test)]

@@ -1,9 +1,9 @@
 //! Power-law spring-dashpot for disks, paper 000 eq. 2–5 (SPEC 2.1).
 
 use super::restitution::{PairTable, PerMass};
+use super::spec::{ParamError, ResolvedPair, SpringDashpotSpec};
 use super::tangential::{coulomb_spring, spring_energy};
 use super::{ContactInput, ContactOutput, clamp_non_negative};
-use crate::scene::{ResolvedPair, SceneError, SpringDashpotSpec};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct SpringDashpot {
@@ -34,7 +34,7 @@ pub const REFERENCE_OVERLAP: f64 = 0.05;
 
 impl SpringDashpot {
     /// `materials`: the scene's material names in index order (the pair table's rows).
-    pub fn from_spec(s: &SpringDashpotSpec, materials: &[String]) -> Result<Self, SceneError> {
+    pub fn from_spec(s: &SpringDashpotSpec, materials: &[String]) -> Result<Self, ParamError> {
         if s.restitution.is_some() || s.contact_time.is_some() {
             return Self::from_material_form(s, materials);
         }
@@ -47,14 +47,14 @@ impl SpringDashpot {
             "belongs to the material form: give restitution and contact_time instead of k_n",
         )?;
         let Some(k_n) = s.k_n else {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 "contact.k_n",
                 "is required (or give restitution and contact_time, the material form)",
             ));
         };
         positive("contact.k_n", k_n)?;
         if !(s.nu >= 1.0 && s.nu <= 3.0) {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 "contact.nu",
                 format!(
                     "must be in [1, 3] (1 Hooke, 1.5 Hertz, 2 conical), got {}",
@@ -63,7 +63,7 @@ impl SpringDashpot {
             ));
         }
         if !(s.psi >= 0.0 && s.psi <= 3.0) {
-            return Err(SceneError::invalid(
+            return Err(ParamError::invalid(
                 "contact.psi",
                 format!("must be in [0, 3], got {}", s.psi),
             ));
@@ -71,7 +71,7 @@ impl SpringDashpot {
         let delta0 = match s.delta0 {
             Some(d) => positive("contact.delta0", d)?,
             None if s.nu != 1.0 || s.psi != 0.0 => {
-                return Err(SceneError::invalid(
+                return Err(ParamError::invalid(
                     "contact.delta0",
                     "is required when nu ≠ 1 or psi ≠ 0",
                 ));
@@ -99,7 +99,7 @@ impl SpringDashpot {
 
     /// The material form: e and t_c (and μ) for every pair of materials, resolved into
     /// coefficients per unit of reduced mass (src/law/restitution.rs).
-    fn from_material_form(s: &SpringDashpotSpec, materials: &[String]) -> Result<Self, SceneError> {
+    fn from_material_form(s: &SpringDashpotSpec, materials: &[String]) -> Result<Self, ParamError> {
         let (e, t_c) = super::restitution::given_pair(s.restitution, s.contact_time)?;
         super::restitution::refuse(
             &[
@@ -124,7 +124,7 @@ impl SpringDashpot {
             None
         } else {
             if !(s.nu >= 1.0 && s.nu <= 3.0 && s.psi >= 0.0 && s.psi <= 3.0) {
-                return Err(SceneError::invalid(
+                return Err(ParamError::invalid(
                     "contact.nu",
                     format!(
                         "must be in [1, 3] with psi in [0, 3], got nu = {}, psi = {}",
@@ -133,13 +133,13 @@ impl SpringDashpot {
                 ));
             }
             let Some(delta0) = s.delta0 else {
-                return Err(SceneError::invalid(
+                return Err(ParamError::invalid(
                     "contact.delta0",
                     "is required when nu ≠ 1 or psi ≠ 0",
                 ));
             };
             let Some(v) = s.impact_speed else {
-                return Err(SceneError::invalid(
+                return Err(ParamError::invalid(
                     "contact.impact_speed",
                     "is required for restitution and contact_time with a nonlinear law (nu ≠ 1 or psi ≠ 0): they hold at that relative speed of a head-on collision only",
                 ));
@@ -165,7 +165,7 @@ impl SpringDashpot {
                     positive(&format!("{at}.contact_time"), t_c)?;
                     super::restitution::per_mass_power(e, t_c, v, (s.nu, s.psi, delta0), s.clamp)
                         .ok_or_else(|| {
-                            SceneError::invalid(
+                            ParamError::invalid(
                                 format!("{at}.restitution"),
                                 format!(
                                     "must be in (0, 1] and reachable by damping the law (got {e})"
@@ -304,25 +304,122 @@ pub fn elastic_energy(k_n: f64, delta0: f64, nu: f64, delta: f64) -> f64 {
     k_n * delta0 * delta0 * x.powf(nu + 1.0) / (nu + 1.0)
 }
 
-pub(crate) fn positive(path: &str, v: f64) -> Result<f64, SceneError> {
+pub(crate) fn positive(path: &str, v: f64) -> Result<f64, ParamError> {
     if v.is_finite() && v > 0.0 {
         Ok(v)
     } else {
-        Err(SceneError::invalid(
+        Err(ParamError::invalid(
             path,
             format!("must be positive, got {v}"),
         ))
     }
 }
 
-pub(crate) fn non_negative(path: &str, v: f64) -> Result<f64, SceneError> {
+pub(crate) fn non_negative(path: &str, v: f64) -> Result<f64, ParamError> {
     if v.is_finite() && v >= 0.0 {
         Ok(v)
     } else {
-        Err(SceneError::invalid(
+        Err(ParamError::invalid(
             path,
             format!("must be zero or positive, got {v}"),
         ))
+    }
+}
+
+impl SpringDashpot {
+    /// `talus check`'s table of the spring-dashpot law per pair of materials: the
+    /// coefficients, and the restitution and contact time they give, for typical particles
+    /// (`masses`, by material: `scene::typical_masses`) colliding with a moving one and with
+    /// a fixed one or a wall (infinitely heavy).
+    pub fn describe(&self, materials: &[String], masses: &[Option<f64>]) -> Vec<String> {
+        let law = self;
+        let clamp = if law.clamp {
+            "clamped f_n ≥ 0"
+        } else {
+            "unclamped"
+        };
+        let mut out = Vec::new();
+        let linear = law.nu == 1.0 && law.psi == 0.0;
+        match &law.pairs {
+            Some(_) => out.push(format!(
+                "contact: material form ({clamp}{}): every contact has k = m_eff · k/m of its pair, m_eff its reduced mass (a fixed partner or a wall infinitely heavy)",
+                match law.impact_speed {
+                    Some(v) => format!(", ν = {}, ψ = {}: e and t_c at the impact speed {v}", law.nu, law.psi),
+                    None => String::new(),
+                }
+            )),
+            None if linear => out.push(format!(
+                "contact: stiffness form ({clamp}): k_n = {}, γ_n = {}, k_t = {}, γ_t = {}, μ = {}; what they give:",
+                law.k_n, law.gamma_n, law.k_t, law.gamma_t, law.mu
+            )),
+            None => {
+                out.push(format!(
+                    "contact: nonlinear spring-dashpot (ν = {}, ψ = {}): restitution and contact time depend on the impact speed, not tabulated",
+                    law.nu, law.psi
+                ));
+                return out;
+            }
+        }
+        let side = materials.len() + 1;
+        let name = |k: usize| {
+            materials
+                .get(k)
+                .map_or(crate::law::spec::WALLS, |s| s.as_str())
+        };
+        // One line per pair and per kind of partner: (m_eff, what it is).
+        let collide = |kappa: f64, c: f64| match super::restitution::collision(kappa, c, law.clamp)
+        {
+            Some((e, t_c)) => format!("e {e:.3}, t_c {t_c:.3e}"),
+            None => "no bounce (overdamped)".to_string(),
+        };
+        for a in 0..materials.len() {
+            let Some(ma) = masses[a] else { continue };
+            for b in a..side {
+                let partners: Vec<(f64, String)> = if b == side - 1 {
+                    vec![(ma, "a wall".to_string())]
+                } else {
+                    let Some(mb) = masses[b] else { continue };
+                    vec![
+                        (ma * mb / (ma + mb), "two moving".to_string()),
+                        (ma, format!("a moving {} on a fixed {}", name(a), name(b))),
+                    ]
+                };
+                let pair = format!("  {}–{}:", name(a), name(b));
+                match &law.pairs {
+                    Some(t) => {
+                        let p = t.coeffs[a * t.side + b];
+                        let bounce = match law.collision(&p) {
+                            Some((e, t_c)) => format!("e {e:.3}, t_c {t_c:.3e}"),
+                            None => "no bounce (overdamped)".to_string(),
+                        };
+                        let mut line = format!(
+                            "{pair} {bounce}, μ {}; per unit mass k_n {:.4e}, γ_n {:.4e}, k_t {:.4e}, γ_t {:.4e}",
+                            p.mu, p.k_n, p.gamma_n, p.k_t, p.gamma_t
+                        );
+                        for (m, what) in partners {
+                            line += &format!(
+                                "; {what} (m_eff {m:.4}): k_n {:.4e}, γ_n {:.4e}",
+                                p.k_n * m,
+                                p.gamma_n * m
+                            );
+                        }
+                        out.push(line);
+                    }
+                    None => {
+                        let parts: Vec<String> = (partners.iter())
+                            .map(|(m, what)| {
+                                format!(
+                                    "{what} (m_eff {m:.4}): {}",
+                                    collide(law.k_n / m, law.gamma_n / m)
+                                )
+                            })
+                            .collect();
+                        out.push(format!("{pair} {}", parts.join("; ")));
+                    }
+                }
+            }
+        }
+        out
     }
 }
 

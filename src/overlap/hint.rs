@@ -26,7 +26,7 @@
 //! resumed from a checkpoint (which keeps no hints) stays bitwise the same as one that
 //! went on.
 
-use super::polygon::{Outline, along, chord_frame};
+use super::outline::{Outline, along, chord_frame};
 use super::{AreaContact, dot, norm, pair_scale, reduced_arm, sub, unit_or_up};
 use crate::base::geometry::cross;
 use crate::shape::P2;
@@ -182,7 +182,7 @@ pub const NO_BOX: (P2, P2) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
 /// The first edge of `edges` (a mask) of `a` whose line separates it from `b`, and the
 /// corner of b that reaches deepest towards it.
 pub fn separating_edge(a: &Outline, edges: u32, b: &Outline) -> Option<(usize, usize)> {
-    super::polygon::bits(edges).find_map(|k| {
+    super::outline::bits(edges).find_map(|k| {
         let mut corner = 0;
         separated_by(a, k, b, &mut corner).then_some((k, corner))
     })

@@ -31,6 +31,7 @@
 mod clip;
 mod disk;
 mod hint;
+mod outline;
 mod polygon;
 pub mod spheropolygon;
 mod wall;
@@ -38,7 +39,8 @@ mod wall;
 pub use clip::{END_A_LINE, END_B_LINE, MAX_CLIP, Q_LINE, WALL_LINE};
 pub use disk::{disk_disk_area, disk_wall_area, polygon_disk, segment_area, x_minus_sin};
 pub use hint::{Chain, Hint, Seen, THICKNESS_FLOOR};
-pub use polygon::{Outline, polygon_polygon, polygon_polygon_hinted, polygon_polygon_of};
+pub use outline::Outline;
+pub use polygon::{polygon_polygon, polygon_polygon_hinted, polygon_polygon_of};
 pub use wall::polygon_wall;
 
 use crate::shape::P2;
@@ -81,7 +83,7 @@ pub(crate) fn corner_mean(v: &[P2]) -> P2 {
 /// A polygon pair's length scale for its tolerances: |d|₁ + r_p + r_q (the 1-norm: a
 /// scale needs no square root).
 #[inline(always)]
-pub(crate) fn pair_scale(p: &polygon::Outline, q: &polygon::Outline, d: P2) -> f64 {
+pub(crate) fn pair_scale(p: &Outline, q: &Outline, d: P2) -> f64 {
     d[0].abs() + d[1].abs() + p.reach + q.reach
 }
 

@@ -154,7 +154,7 @@ pub fn expected_moving(sim: &Simulation, t: f64) -> f64 {
                 0
             } else {
                 (((t - l.start_time) / l.interval).floor() as u64 + 1)
-                    .min(create::layered::max_rows(l) as u64)
+                    .min(crate::scene::rows::max_rows(l) as u64)
             };
             n += (state.inserted as u64..rows.max(state.inserted as u64))
                 .map(|r| create::layered::row_capacity(l, r as u32) as f64)

@@ -5,24 +5,25 @@
 //! values (positive radii, known materials, a time step the stiffness allows) and names
 //! the offending key too. Nothing downstream re-checks user input.
 
-mod contact;
 mod overrides;
+pub mod rows;
 mod schema;
+mod sizes;
 mod stability;
 mod strict;
 mod validate;
 
-pub use contact::*;
+pub use crate::law::spec::*;
 pub use overrides::apply_override;
 pub use schema::*;
+pub use sizes::{
+    material_of, max_diameter, polygon_of, reach_bound_of, smallest_particle_area, typical_masses,
+};
 pub use stability::{
     DAMPING_STABILITY, IMPACT_DAMPING_STABILITY, MIN_STEPS_PER_CONTACT,
     RECOMMENDED_STEPS_PER_CONTACT, shortest_contact_time,
 };
-pub use validate::{
-    material_of, max_diameter, polygon_of, reach_bound_of, smallest_particle_area, typical_masses,
-    validate,
-};
+pub use validate::validate;
 
 /// Non-fatal remarks about a valid scene (e.g. dt above t_c/10).
 pub fn warnings(scene: &Scene) -> Vec<String> {
@@ -43,6 +44,15 @@ pub enum SceneError {
     Syntax(String),
     #[error("{path}: {reason}")]
     Invalid { path: String, reason: String },
+}
+
+impl From<crate::law::spec::ParamError> for SceneError {
+    fn from(e: crate::law::spec::ParamError) -> Self {
+        Self::Invalid {
+            path: e.path,
+            reason: e.reason,
+        }
+    }
 }
 
 impl SceneError {
@@ -179,5 +189,31 @@ fn refine_tagged_error(root: &serde_json::Value, path: &str) -> Option<SceneErro
         "point_source" => inner::<PointSource>(block, "kind", path),
         "list" => inner::<ParticleList>(block, "kind", path),
         _ => None,
+    }
+}
+
+/// The contact law of a scene: its `contact` block with the scene's gravity, materials
+/// and each material's corner count (the law's own parameters come from the block alone,
+/// `ContactLaw::from_spec`).
+impl crate::law::ContactLaw {
+    /// The contact law of a scene.
+    pub fn of_scene(scene: &Scene) -> Result<Self, SceneError> {
+        let g = scene.gravity.g;
+        let materials: Vec<String> = scene.materials.keys().cloned().collect();
+        // Each material's corner count: its first polygon block's (0 for disks).
+        let corners: Vec<u32> = (materials.iter())
+            .map(|m| {
+                (scene.particles.iter())
+                    .filter(|c| material_of(c) == m)
+                    .find_map(|c| polygon_of(c).map(|p| p.corners))
+                    .unwrap_or(0)
+            })
+            .collect();
+        Ok(Self::from_spec(
+            &scene.contact,
+            (g[0] * g[0] + g[1] * g[1]).sqrt(),
+            &materials,
+            &corners,
+        )?)
     }
 }

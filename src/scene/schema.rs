@@ -3,7 +3,7 @@
 //! Every struct denies unknown keys. Lengths, times and masses are in the scene's units;
 //! `units` only labels them ("si" or "reduced", paper 001's σ, m, g).
 
-use super::contact::ContactSpec;
+use crate::law::spec::{ContactSpec, one, yes};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -135,12 +135,8 @@ pub struct Material {
     pub thickness: f64,
 }
 
-pub(super) fn one() -> f64 {
-    1.0
-}
-
 /// A rod (paper 004 sec. 2): a stadium of width the particle's `diameter` and length
-/// `aspect` times that (a segment swept by half the width; src/spheropolygon.rs).
+/// `aspect` times that (a segment swept by half the width; src/shape/spheropolygon.rs).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RodSpec {
@@ -238,10 +234,6 @@ pub struct LatticePile {
     /// Convex polygons instead of disks.
     #[serde(default)]
     pub polygon: Option<PolygonSpec>,
-}
-
-pub(super) fn yes() -> bool {
-    true
 }
 
 /// A straight horizontal row of equal disks, e.g. a bumpy substrate (paper 001).

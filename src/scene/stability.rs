@@ -2,7 +2,7 @@
 //! (an error when dt exceeds t_c/5), and the warnings where an integrator is known to
 //! go unstable with the scene's damping (measured bounds, each with its runs).
 
-use super::validate::{material_of, max_diameter, size_bounds, smallest_area};
+use super::sizes::{material_of, max_diameter, size_bounds, smallest_area};
 use super::{Creation, Scene, SceneError};
 use crate::law::ContactLaw;
 

@@ -219,7 +219,7 @@ impl Simulation {
         (self.sources.chunks(n.max(1))).all(|copy| {
             (sources.iter().zip(copy)).all(|(spec, st)| st.done(spec))
                 && (layered.iter().zip(&copy[p..]))
-                    .all(|(spec, st)| st.inserted >= create::layered::max_rows(spec))
+                    .all(|(spec, st)| st.inserted >= crate::scene::rows::max_rows(spec))
         }) && self.time() >= self.scene.gravity.ramp_time
     }
 

@@ -1,8 +1,37 @@
 //! The `contact` block of a scene: which law, and its coefficients as the scene gives
-//! them (SPEC 2; resolved into a `law::ContactLaw` by src/law/).
+//! them (SPEC 2; resolved into a `ContactLaw` by `ContactLaw::from_spec`). The scene's
+//! schema holds it (`scene::Scene::contact`); a parameter out of range is a
+//! [`ParamError`] naming its key, which the scene reports as its own error.
 
-use super::schema::{one, yes};
 use serde::{Deserialize, Serialize};
+
+/// A contact parameter the law cannot take: its key path and the reason (the scene turns
+/// it into `SceneError::Invalid`).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{path}: {reason}")]
+pub struct ParamError {
+    pub path: String,
+    pub reason: String,
+}
+
+impl ParamError {
+    pub fn invalid(path: impl Into<String>, reason: impl Into<String>) -> Self {
+        Self {
+            path: path.into(),
+            reason: reason.into(),
+        }
+    }
+}
+
+/// Serde's default for keys that are 1 unless given (here and in the scene's schema).
+pub(crate) fn one() -> f64 {
+    1.0
+}
+
+/// Serde's default for switches that are on unless given.
+pub(crate) fn yes() -> bool {
+    true
+}
 
 /// The contact law between all particles and walls (SPEC 2.1, 2.2).
 #[derive(Clone, Debug, Serialize, Deserialize)]
