@@ -129,7 +129,7 @@ pub fn shared() -> Vec<(&'static str, Value)> {
         u("TWO_PI_Q29", orientation::TWO_PI_Q29),
         // geometry.wgsl
         f("Q30", layout::Q30),
-        // polygon.wgsl
+        // polygon_outline.wgsl
         u("MAX_CORNERS", crate::shape::MAX_CORNERS),
         // spheropolygon.wgsl
         u("VERTEX_I", sp::VERTEX_I),

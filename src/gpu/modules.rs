@@ -14,7 +14,16 @@ const COMMON: &str = include_str!("../../shaders/common.wgsl");
 const POSITION: &str = include_str!("../../shaders/position.wgsl");
 const ORIENTATION: &str = include_str!("../../shaders/orientation.wgsl");
 const GEOMETRY: &str = include_str!("../../shaders/geometry.wgsl");
-const POLYGON: &str = include_str!("../../shaders/polygon.wgsl");
+/// The overlap-area law's geometry, one query a file, in this order (polygon_outline.wgsl
+/// holds what they share; area_contact.wgsl picks a pair's query).
+const POLYGON: [&str; 6] = [
+    include_str!("../../shaders/polygon_outline.wgsl"),
+    include_str!("../../shaders/polygon.wgsl"),
+    include_str!("../../shaders/polygon_wall.wgsl"),
+    include_str!("../../shaders/disk_area.wgsl"),
+    include_str!("../../shaders/polygon_disk.wgsl"),
+    include_str!("../../shaders/area_contact.wgsl"),
+];
 const LAWS: &str = include_str!("../../shaders/laws.wgsl");
 const SPHEROPOLYGON: &str = include_str!("../../shaders/spheropolygon.wgsl");
 
@@ -99,7 +108,12 @@ pub const MODULES: &[ModuleSource] = &[
             POSITION,
             ORIENTATION,
             GEOMETRY,
-            POLYGON,
+            POLYGON[0],
+            POLYGON[1],
+            POLYGON[2],
+            POLYGON[3],
+            POLYGON[4],
+            POLYGON[5],
             include_str!("../../shaders/find_contacts.wgsl"),
         ],
     },
@@ -119,7 +133,12 @@ pub const MODULES: &[ModuleSource] = &[
             POSITION,
             ORIENTATION,
             GEOMETRY,
-            POLYGON,
+            POLYGON[0],
+            POLYGON[1],
+            POLYGON[2],
+            POLYGON[3],
+            POLYGON[4],
+            POLYGON[5],
             LAWS,
             SPHEROPOLYGON,
             include_str!("../../shaders/contact_forces.wgsl"),
