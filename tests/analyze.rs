@@ -8,9 +8,7 @@ use std::path::{Path, PathBuf};
 use talus::analyze::{self, Options};
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("talus-analyze-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp("analyze", name)
 }
 
 /// Writes a snapshot of `sim` into `dir` and analyses it.
@@ -203,14 +201,8 @@ fn the_command_writes_its_tables_and_rejects_bad_input() {
     let dir = tmp("command");
     let json = talus::io::snapshot::write(&s, &dir, "snap").unwrap();
     let run = |args: &[&str]| {
-        let out = std::process::Command::new(common::talus_bin())
-            .args(args)
-            .output()
-            .unwrap();
-        (
-            out.status.code().unwrap_or(-1),
-            String::from_utf8_lossy(&out.stderr).into_owned(),
-        )
+        let (code, _, err) = common::talus(args);
+        (code, err)
     };
     let out = dir.join("analysis");
     let (code, err) = run(&[
@@ -335,12 +327,8 @@ fn damaged_snapshots_are_refused_by_analyze_and_render() {
             "{name}: {e:?}"
         );
         for cmd in ["analyze", "render"] {
-            let out = std::process::Command::new(common::talus_bin())
-                .args([cmd, d.join("snap.json").to_str().unwrap()])
-                .output()
-                .unwrap();
-            let err = String::from_utf8_lossy(&out.stderr);
-            assert_ne!(out.status.code(), Some(0), "{cmd} {name}");
+            let (code, _, err) = common::talus([cmd, d.join("snap.json").to_str().unwrap()]);
+            assert_ne!(code, 0, "{cmd} {name}");
             assert!(!err.contains("panicked"), "{cmd} {name}: {err}");
         }
     }
@@ -352,19 +340,18 @@ fn render_draws_pictures_and_vtk_files_of_the_column() {
     let dir = tmp("render");
     let json = talus::io::snapshot::write(&s, &dir, "snap").unwrap();
     let out = dir.join("pictures");
-    let o = std::process::Command::new(common::talus_bin())
-        .args([
-            "render",
-            json.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--width",
-            "400",
-            "--g",
-            "1",
-        ])
-        .output()
-        .unwrap();
+    let o = common::command([
+        "render",
+        json.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--width",
+        "400",
+        "--g",
+        "1",
+    ])
+    .output()
+    .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     for stem in ["grains", "forces", "stress_crosses"] {
         let png = std::fs::read(out.join(format!("{stem}.png"))).unwrap();
@@ -532,25 +519,24 @@ fn grains_that_rolled_away_do_not_widen_the_heap() {
 #[test]
 fn a_run_with_output_vtk_writes_a_paraview_time_series() {
     let dir = tmp("vtk-run");
-    let o = std::process::Command::new(common::talus_bin())
-        .args([
-            "run",
-            "-q",
-            "--backend",
-            "cpu",
-            "--out",
-            dir.to_str().unwrap(),
-            "--set",
-            "output.vtk=true",
-            "--set",
-            "output.snapshot_every=1",
-            "--set",
-            "stop.time=3",
-            "--set",
-            "stop.kinetic_fraction=null",
-        ])
-        .output()
-        .unwrap();
+    let o = common::command([
+        "run",
+        "-q",
+        "--backend",
+        "cpu",
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        "output.vtk=true",
+        "--set",
+        "output.snapshot_every=1",
+        "--set",
+        "stop.time=3",
+        "--set",
+        "stop.kinetic_fraction=null",
+    ])
+    .output()
+    .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let pvd = std::fs::read_to_string(dir.join("snapshots/snapshots.pvd")).unwrap();
     // Snapshots at t = 1, 2, 3 have grains (t = 0 is before the first one falls in).
@@ -1184,8 +1170,7 @@ fn vtk_draws_disks_as_points_and_polygons_as_their_outlines() {
 
 /// `talus render` of a snapshot into `out`, small pictures.
 fn render(snapshot: &Path, out: &Path) {
-    let o = std::process::Command::new(common::talus_bin())
-        .args(["render", "--width", "64", "--out"])
+    let o = common::command(["render", "--width", "64", "--out"])
         .arg(out)
         .arg(snapshot)
         .output()
@@ -1295,8 +1280,7 @@ fn render_writes_a_lammps_style_dump_that_holds_the_snapshot_exactly() {
 #[test]
 fn a_run_with_output_dump_writes_one_dump_per_snapshot() {
     let dir = tmp("dump-run");
-    let o = std::process::Command::new(common::talus_bin())
-        .args(["run", "-q", "--backend", "cpu", "--out"])
+    let o = common::command(["run", "-q", "--backend", "cpu", "--out"])
         .arg(&dir)
         .args([
             "--set",

@@ -441,3 +441,24 @@ fn no_new_file_at_the_top_of_src() {
         "new files at the top of src/ (put them in a layer): {new:?}\nlisted but gone: {gone:?}"
     );
 }
+
+/// The library does not depend on clap: only the binary (`src/main.rs`, `src/cli/`)
+/// parses a command line, so a program that links `talus` gets no argument parser.
+#[test]
+fn only_the_binary_names_clap() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    let mut named = Vec::new();
+    for f in &files {
+        let module = module_of(&src, f);
+        if module.first().is_some_and(|m| m == "cli") || f.ends_with("main.rs") {
+            continue;
+        }
+        let text = code(&std::fs::read_to_string(f).unwrap());
+        if text.contains("clap::") || text.contains("use clap") {
+            named.push(f.strip_prefix(&src).unwrap().display().to_string());
+        }
+    }
+    assert!(named.is_empty(), "clap named in the library: {named:?}");
+}

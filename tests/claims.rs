@@ -8,9 +8,7 @@ use serde_json::{Value, json};
 use std::path::PathBuf;
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("talus-claims-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp("claims", name)
 }
 
 #[test]
@@ -19,14 +17,8 @@ fn reproduce_r1_gives_the_papers_stress_ratio_of_one_third() {
     // interior of the first mobile row S_xx/S_zz = tan² 30° = 1/3, for ν = 1 and 3/2.
     let dir = tmp("reproduce");
     let run = |args: &[&str]| {
-        let o = std::process::Command::new(common::talus_bin())
-            .args(args)
-            .output()
-            .unwrap();
-        (
-            o.status.code().unwrap_or(-1),
-            String::from_utf8_lossy(&o.stderr).into_owned(),
-        )
+        let (code, _, err) = common::talus(args);
+        (code, err)
     };
     let (code, err) = run(&[
         "reproduce",
@@ -63,8 +55,7 @@ fn reproduce_r1_gives_the_papers_stress_ratio_of_one_third() {
 /// succeed: the folder and its reproduce.json.
 fn reproduce(name: &str, args: &[&str]) -> (PathBuf, Value) {
     let dir = tmp(name);
-    let o = std::process::Command::new(common::talus_bin())
-        .arg("reproduce")
+    let o = common::command(["reproduce"])
         .args(args)
         .args(["--backend", "cpu", "-q", "--out"])
         .arg(&dir)
@@ -156,20 +147,19 @@ fn reproduce_r2_dips_under_a_squeezed_bottom_only() {
         "S_zz(1) under the apex falls with the squeeze"
     );
     // --reuse measures a finished run again without running it; --only picks it.
-    let o = std::process::Command::new(common::talus_bin())
-        .args([
-            "reproduce",
-            "R2",
-            "--backend",
-            "cpu",
-            "--reuse",
-            "--only",
-            "c=0",
-            "--out",
-        ])
-        .arg(&dir)
-        .output()
-        .unwrap();
+    let o = common::command([
+        "reproduce",
+        "R2",
+        "--backend",
+        "cpu",
+        "--reuse",
+        "--only",
+        "c=0",
+        "--out",
+    ])
+    .arg(&dir)
+    .output()
+    .unwrap();
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         o.status.success() && err.contains("(finished run reused)"),

@@ -3,33 +3,18 @@
 
 use serde_json::json;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn talus(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_talus"))
-        .args(args)
-        .output()
-        .expect("binary runs");
-    (
-        out.status.code().unwrap_or(-1),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
+mod common;
+
+use common::{command, talus};
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("talus-cli-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp("cli", name)
 }
 
 /// The default scene with one edit applied to its JSON text.
 fn scene_file(name: &str, edit: impl Fn(&mut serde_json::Value)) -> PathBuf {
-    let mut v: serde_json::Value = serde_json::from_str(talus::scene::DEFAULT_SCENE).unwrap();
-    edit(&mut v);
-    let p = tmp(name).join("scene.json");
-    std::fs::write(&p, v.to_string()).unwrap();
-    p
+    common::cli::default_scene_file(&tmp(name), edit)
 }
 
 fn assert_rejected(args: &[&str], must_mention: &[&str]) {
@@ -69,7 +54,7 @@ fn duplicate_keys_and_arrays_for_objects_are_named() {
         v["particles"][1]["velocity_spread"] = serde_json::json!(null);
         v["materials"] = serde_json::json!([[1.0]]);
     });
-    let (code, _, err) = talus(&["check", p.to_str().unwrap()]);
+    let (code, _, err) = talus(["check", p.to_str().unwrap()]);
     assert_eq!(code, 2, "{err}");
 }
 
@@ -88,7 +73,7 @@ fn absurd_counts_are_refused_before_anything_is_allocated() {
     assert_rejected(&["bench", "--sizes", "0"], &["--sizes"]);
     assert_rejected(&["bench", "--rod-sizes", "30000000"], &["--rod-sizes"]);
     // Meant: the limit raised, the same count is taken (a source streams its particles).
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "check",
         "--set",
         "particles[1].count=40000000",
@@ -121,7 +106,7 @@ fn what_a_scene_creates_where_it_cannot_work_is_refused() {
         &["check", "--set", "particles[1].position=[0,0.5]"],
         &["particles[1].position", "blocked everywhere"],
     );
-    let (code, _, err) = talus(&["check", "--set", "particles[1].position=[0,1.6]"]);
+    let (code, _, err) = talus(["check", "--set", "particles[1].position=[0,1.6]"]);
     assert_eq!(code, 0, "{err}");
 }
 
@@ -132,7 +117,7 @@ fn a_name_that_is_a_path_is_refused() {
         let set = format!("name={name}");
         assert_rejected(&["check", "--set", &set], &["name", "plain name"]);
     }
-    let (code, out, err) = talus(&["check", "--set", "name=heap-2.v1_x+y"]);
+    let (code, out, err) = talus(["check", "--set", "name=heap-2.v1_x+y"]);
     assert_eq!(code, 0, "{out}{err}");
 }
 
@@ -189,7 +174,7 @@ fn time_step_too_large_for_the_stiffness() {
         &["dt", "too large"],
     );
     // a mildly large dt only warns
-    let (code, _, err) = talus(&["check", "--set", "dt=0.006"]);
+    let (code, _, err) = talus(["check", "--set", "dt=0.006"]);
     assert_eq!(code, 0, "{err}");
     assert!(err.contains("warning") && err.contains("t_c/10"), "{err}");
 }
@@ -270,14 +255,14 @@ fn the_material_form_refuses_what_does_not_belong() {
 /// the run's scene.json records the resolved coefficients.
 #[test]
 fn check_prints_the_resolved_pairs_and_the_run_records_them() {
-    let (code, out, err) = talus(&["check"]);
+    let (code, out, err) = talus(["check"]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("material form"), "{out}");
     assert!(out.contains("grain–grain: e 0.750, t_c 5.000e-2"), "{out}");
     assert!(out.contains("grain–walls"), "{out}");
     // The stiffness form says what restitution its absolute damping gives each kind of
     // partner (not the same on a fixed one: the reason for the material form).
-    let (_, out, _) = talus(&[
+    let (_, out, _) = talus([
         "check",
         "--set",
         r#"contact={"law": "spring_dashpot", "k_n": 2000, "gamma_n": 10}"#,
@@ -288,7 +273,7 @@ fn check_prints_the_resolved_pairs_and_the_run_records_them() {
         "{out}"
     );
     let dir = tmp("resolved");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "--out",
         dir.to_str().unwrap(),
@@ -329,7 +314,7 @@ fn check_warns_when_resting_overlaps_are_below_the_gpu_resolution() {
     // d), so resting overlaps below ~1e-6 d get forces off by more than 1e-3 there. The
     // default heap with contacts of 7e-5 (k_n/m ≈ 2e9) rests at ~5e-10 d: a warning, not
     // an error.
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "check",
         "--set",
         "contact.contact_time=7e-5",
@@ -342,7 +327,7 @@ fn check_warns_when_resting_overlaps_are_below_the_gpu_resolution() {
         "{err}"
     );
     // At its own contact time (k_n/m ≈ 4e3) it rests at ~2.5e-4 d: no such warning.
-    let (_, _, err) = talus(&["check"]);
+    let (_, _, err) = talus(["check"]);
     assert!(!err.contains("GPU path resolves"), "{err}");
 }
 
@@ -360,7 +345,7 @@ fn unreadable_or_malformed_files() {
 
 #[test]
 fn check_accepts_the_default_scene() {
-    let (code, out, err) = talus(&["check"]);
+    let (code, out, err) = talus(["check"]);
     assert_eq!(code, 0, "{err}");
     assert!(out.contains("81 particles at start (81 fixed)"), "{out}");
     // And what its pour will add, and when (issue 41 item 7): 800 disks at 5 per time
@@ -370,7 +355,7 @@ fn check_accepts_the_default_scene() {
             && out.contains("created during the run: up to 800 particles, 881 in all"),
         "{out}"
     );
-    let (code, out, err) = talus(&["check", "--set", "replicas=3"]);
+    let (code, out, err) = talus(["check", "--set", "replicas=3"]);
     assert_eq!(code, 0, "{err}");
     assert!(
         out.contains("800 disks in each of the 3 copies")
@@ -379,7 +364,7 @@ fn check_accepts_the_default_scene() {
     );
     // A layered pile: its rows, at most.
     let scene = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/r7_layered_medium.json");
-    let (code, out, err) = talus(&["check", scene]);
+    let (code, out, err) = talus(["check", scene]);
     assert_eq!(code, 0, "{err}");
     assert!(
         out.contains("layered pile 0: at most ") && out.contains("a row every 1 s"),
@@ -406,7 +391,7 @@ fn diverging_run_stops_with_step_ids_and_checkpoint() {
     });
     std::fs::write(&p, scene.to_string()).unwrap();
     let out = tmp("diverge").join("out");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         p.to_str().unwrap(),
@@ -430,7 +415,7 @@ fn diverging_run_stops_with_step_ids_and_checkpoint() {
 
 #[test]
 fn gpu_backend_runs_the_default_scene_and_info_lists_adapters() {
-    let (code, out, err) = talus(&["info"]);
+    let (code, out, err) = talus(["info"]);
     assert_eq!(code, 0, "{err}");
     assert!(
         out.contains("GPU adapters (Vulkan, Metal, DX12)") && out.contains("--backend auto"),
@@ -438,7 +423,7 @@ fn gpu_backend_runs_the_default_scene_and_info_lists_adapters() {
     );
     let has_gpu = !out.contains("none found");
     let dir = tmp("gpu");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "--backend",
         "gpu",
@@ -506,7 +491,7 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
     }
     let ckpt = first.join("checkpoints/ckpt_0000002000.bin");
     let second = dir.join("second");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--resume",
@@ -522,7 +507,7 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
             .unwrap();
     assert_eq!(summary["time"], 6.0);
     assert_eq!(summary["steps"], 1000);
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--resume",
@@ -540,7 +525,7 @@ fn resume_extends_a_run_and_refuses_physics_changes() {
     // again.
     let log_before = std::fs::read_to_string(first.join("log.csv")).unwrap();
     let midway = first.join("checkpoints/ckpt_0000001000.bin");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--resume",
@@ -578,7 +563,7 @@ fn every_output_says_what_wrote_it() {
     // Issue 41 item 3: talus --version names the commit; a run's summary.json, its
     // snapshots and its log carry the version, the commit, the command line, the
     // threads and the backend.
-    let (code, version, err) = talus(&["--version"]);
+    let (code, version, err) = talus(["--version"]);
     assert_eq!(code, 0, "{err}");
     let commit = talus::base::provenance::COMMIT;
     assert_eq!(
@@ -597,7 +582,7 @@ fn every_output_says_what_wrote_it() {
         assert_eq!(commit, String::from_utf8_lossy(&o.stdout).trim());
     }
     let out = tmp("provenance");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--threads",
@@ -674,7 +659,7 @@ fn a_folder_holding_another_run_is_refused_unless_forced() {
             args.extend(["--set".into(), set]);
         }
         args.extend(extra.iter().map(|s| s.to_string()));
-        talus(&args.iter().map(String::as_str).collect::<Vec<_>>())
+        talus(args.iter().map(String::as_str).collect::<Vec<_>>())
     };
     let (code, _, err) = run("4", "1", &[]);
     assert_eq!(code, 0, "{err}");
@@ -694,7 +679,7 @@ fn a_folder_holding_another_run_is_refused_unless_forced() {
     );
     // Resuming another folder's run into it is refused too.
     let other = tmp("reused").join("other");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--out",
@@ -706,7 +691,7 @@ fn a_folder_holding_another_run_is_refused_unless_forced() {
     ]);
     assert_eq!(code, 0, "{err}");
     let ckpt = other.join("checkpoints/ckpt_0000000500.bin");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--resume",
@@ -740,7 +725,7 @@ fn a_folder_holding_another_run_is_refused_unless_forced() {
     let fresh = tmp("reused").join("fresh");
     std::fs::create_dir_all(&fresh).unwrap();
     std::fs::write(fresh.join("notes.txt"), "mine").unwrap();
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--out",
@@ -761,8 +746,7 @@ fn an_interrupted_run_stops_cleanly_and_names_its_checkpoint() {
     // no summary.json (it marks a finished run) and no temporaries, and says where the
     // last checkpoint is; the run continues from there in its own folder.
     let dir = tmp("interrupt").join("run");
-    let child = Command::new(env!("CARGO_BIN_EXE_talus"))
-        .args(["run", "-q", "--backend", "cpu", "--out"])
+    let child = command(["run", "-q", "--backend", "cpu", "--out"])
         .arg(&dir)
         .args([
             "--set",
@@ -818,7 +802,7 @@ fn an_interrupted_run_stops_cleanly_and_names_its_checkpoint() {
     assert_eq!(std::path::Path::new(named), newest);
     let step: u64 = named[named.len() - 14..named.len() - 4].parse().unwrap();
     let until = format!("stop.time={}", step as f64 * 2e-3 + 0.2);
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--backend",
@@ -871,7 +855,7 @@ fn bench_with_a_time_budget_reports_steps_and_microseconds() {
     // --budget times as many steps as fit (at most --steps), and the JSON carries the
     // per-step figures scripts/gpu-check collects.
     let out = tmp("bench").join("bench.json");
-    let (code, stdout, err) = talus(&[
+    let (code, stdout, err) = talus([
         "bench",
         "--backend",
         "cpu",
@@ -900,9 +884,9 @@ fn bench_with_a_time_budget_reports_steps_and_microseconds() {
     for r in results {
         let steps = r["steps"].as_u64().unwrap();
         let seconds = r["seconds"].as_f64().unwrap();
-        assert!(steps >= 8 && steps < 100000, "budgeted steps: {steps}");
+        assert!((8..100000).contains(&steps), "budgeted steps: {steps}");
         assert!(
-            seconds >= 0.2 && seconds < 5.0,
+            (0.2..5.0).contains(&seconds),
             "within the budget's batch: {seconds}"
         );
         let us = r["microseconds_per_step"].as_f64().unwrap();
@@ -939,7 +923,7 @@ fn a_source_whose_outlet_stays_taken_is_reported() {
     // Both paths: the GPU path's sources advance on the device.
     for backend in ["cpu", "gpu"] {
         let out = dir.join(backend);
-        let (code, _, err) = talus(&[
+        let (code, _, err) = talus([
             "run",
             scene.to_str().unwrap(),
             "-q",
@@ -981,8 +965,7 @@ fn a_headless_machine_gets_no_wayland_noise() {
     // Without a display session Mesa's device-select layer made libwayland print
     // "XDG_RUNTIME_DIR is invalid or not set" several times per process (into every
     // log and Slurm output); talus switches that layer off there.
-    let out = Command::new(env!("CARGO_BIN_EXE_talus"))
-        .arg("info")
+    let out = command(["info"])
         .env_remove("XDG_RUNTIME_DIR")
         .env_remove("NODEVICE_SELECT")
         .env_remove("MESA_VK_DEVICE_SELECT")
@@ -997,7 +980,7 @@ fn a_headless_machine_gets_no_wayland_noise() {
 fn bench_kernels_times_each_kernel_of_the_gpu_path() {
     // --kernels: each GPU workload also gets its device time per kernel (the table
     // scripts/gpu-check collects on a real GPU); the CPU path has no kernels.
-    let (code, stdout, err) = talus(&[
+    let (code, stdout, err) = talus([
         "bench",
         "--backend",
         "cpu",
@@ -1078,7 +1061,7 @@ fn bench_measures_a_software_adapter_only_when_asked() {
         .collect::<Vec<_>>()
     };
     let a = args("auto");
-    let (code, stdout, err) = talus(&a.iter().map(|s| s.as_str()).collect::<Vec<_>>());
+    let (code, stdout, err) = talus(a.iter().map(|s| s.as_str()).collect::<Vec<_>>());
     assert_eq!(code, 0, "{err}");
     let v: serde_json::Value = serde_json::from_str(&stdout).unwrap();
     let backends: Vec<&str> = v["results"]
@@ -1146,7 +1129,7 @@ fn check_estimates_the_run_time() {
     assert!(grown[0].starts_with("cpu: the heap grown to 200"), "{out}");
     assert!(line.contains("as the heap grows"), "{line}");
     // A pile that only settles is timed as it stands.
-    let (code, out, err) = talus(&[
+    let (code, out, err) = talus([
         "check",
         "scenes/r1_pile_reduced.json",
         "--estimate",
@@ -1172,7 +1155,7 @@ fn check_estimates_the_run_time() {
 #[test]
 fn check_says_whether_a_scene_fits_the_gpu() {
     let heap = "scenes/heap_50k.json";
-    let (code, out, err) = talus(&["check", heap, "--backend", "gpu"]);
+    let (code, out, err) = talus(["check", heap, "--backend", "gpu"]);
     if err.contains("no GPU adapter found") {
         assert!(
             !talus::gpu::device::gpu_required(),
@@ -1188,7 +1171,7 @@ fn check_says_whether_a_scene_fits_the_gpu() {
         "{out}"
     );
     assert!(out.contains("the scene fits"), "{out}");
-    let (code, out, err) = talus(&[
+    let (code, out, err) = talus([
         "check",
         heap,
         "--backend",
@@ -1219,9 +1202,9 @@ fn a_stage_goes_on_from_an_earlier_run_under_a_new_scene() {
         dir.join("resumed"),
     );
     let s = |p: &PathBuf| p.to_str().unwrap().to_string();
-    let (code, _, err) = talus(&["run", "-q", "--set", "stop.time=20", "--out", &s(&first)]);
+    let (code, _, err) = talus(["run", "-q", "--set", "stop.time=20", "--out", &s(&first)]);
     assert_eq!(code, 0, "{err}");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--from",
@@ -1251,7 +1234,7 @@ fn a_stage_goes_on_from_an_earlier_run_under_a_new_scene() {
     assert!(summary["particles"].as_u64().unwrap() > before);
     // A stage that changes nothing is the resumed run, bit for bit.
     let ckpt = first.join("checkpoints/ckpt_0000010000.bin");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--from",
@@ -1262,7 +1245,7 @@ fn a_stage_goes_on_from_an_earlier_run_under_a_new_scene() {
         &s(&same),
     ]);
     assert_eq!(code, 0, "{err}");
-    let (code, _, err) = talus(&[
+    let (code, _, err) = talus([
         "run",
         "-q",
         "--resume",

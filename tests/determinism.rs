@@ -23,9 +23,14 @@ fn small_heap(extra: &[&str]) -> talus::scene::Scene {
     scene::parse(scene::DEFAULT_SCENE, &o).expect("valid scene")
 }
 
-fn run_to(dir: &Path, sim: Simulation) {
+/// Runs `sim` to its end on `path` into `dir`; false on the GPU path without an adapter.
+fn run_to(path: common::Path, dir: &Path, sim: Simulation) -> bool {
+    let test = "same_seed_gives_bitwise_identical_snapshots";
+    let Some(mut e) = common::engine(path, test, sim) else {
+        return false;
+    };
     run(
-        &mut talus::run::Engine::cpu(sim),
+        &mut e,
         &RunOptions {
             out: dir.to_path_buf(),
             quiet: true,
@@ -33,6 +38,7 @@ fn run_to(dir: &Path, sim: Simulation) {
         },
     )
     .expect("run succeeds");
+    true
 }
 
 fn assert_same_snapshot(a: &Path, b: &Path) {
@@ -74,23 +80,27 @@ fn assert_same_snapshot(a: &Path, b: &Path) {
 
 #[test]
 fn same_seed_gives_bitwise_identical_snapshots() {
-    let tmp = std::env::temp_dir().join(format!("talus-det-{}", std::process::id()));
-    let (a, b, c) = (tmp.join("a"), tmp.join("b"), tmp.join("c"));
-    run_to(&a, Simulation::new(small_heap(&[])).unwrap());
-    run_to(&b, Simulation::new(small_heap(&[])).unwrap());
-    for step in [3750, 7500, 11250, 15000] {
-        let name = format!("snapshots/snap_{step:010}.json");
-        assert_same_snapshot(&a.join(&name), &b.join(&name));
+    for path in common::PATHS {
+        let tmp = common::tmp("det", &format!("{path:?}"));
+        let (a, b, c) = (tmp.join("a"), tmp.join("b"), tmp.join("c"));
+        if !run_to(path, &a, Simulation::new(small_heap(&[])).unwrap()) {
+            continue;
+        }
+        run_to(path, &b, Simulation::new(small_heap(&[])).unwrap());
+        for step in [3750, 7500, 11250, 15000] {
+            let name = format!("snapshots/snap_{step:010}.json");
+            assert_same_snapshot(&a.join(&name), &b.join(&name));
+        }
+        assert_same_snapshot(&a.join("final.json"), &b.join("final.json"));
+        // A different seed must give a different heap (the test can fail).
+        run_to(path, &c, Simulation::new(small_heap(&["seed=2"])).unwrap());
+        let (fa, fc) = (
+            snapshot::read(&a.join("final.json")).unwrap(),
+            snapshot::read(&c.join("final.json")).unwrap(),
+        );
+        assert_ne!(fa.f64("particles.x"), fc.f64("particles.x"), "{path:?}");
+        std::fs::remove_dir_all(&tmp).ok();
     }
-    assert_same_snapshot(&a.join("final.json"), &b.join("final.json"));
-    // A different seed must give a different heap (the test can fail).
-    run_to(&c, Simulation::new(small_heap(&["seed=2"])).unwrap());
-    let (fa, fc) = (
-        snapshot::read(&a.join("final.json")).unwrap(),
-        snapshot::read(&c.join("final.json")).unwrap(),
-    );
-    assert_ne!(fa.f64("particles.x"), fc.f64("particles.x"));
-    std::fs::remove_dir_all(&tmp).ok();
 }
 
 #[test]
@@ -119,8 +129,8 @@ fn resume_from_checkpoint_is_bitwise_identical() {
 /// Irregular heptagons from a point source (with a pending candidate most of the time)
 /// and a layered block beside it: the shapes, the drawn-but-unplaced particle and the
 /// layers' progress all travel through the checkpoint.
-fn polygon_scene() -> talus::scene::Scene {
-    let v = serde_json::json!({
+fn polygon_scene(layered: bool) -> talus::scene::Scene {
+    let mut v = serde_json::json!({
         "name": "polygon-resume", "dt": 0.002, "seed": 5,
         "stop": { "time": 30.0 },
         "gravity": { "g": [0.0, -1.0] },
@@ -138,20 +148,27 @@ fn polygon_scene() -> talus::scene::Scene {
         ],
         "output": { "snapshot_every": 10.0, "checkpoint_every": 10.0 }
     });
+    if !layered {
+        v["particles"].as_array_mut().unwrap().pop();
+    }
     scene::parse(&v.to_string(), &[]).expect("valid scene")
 }
 
 #[test]
 fn polygon_runs_resume_bitwise() {
-    // CPU only: the GPU path does not take point sources beside layered blocks yet.
     let check = |c: &talus::io::checkpoint::Checkpoint| {
         let p = &c.sim.particles;
         let shapes = p.shape.iter().all(|c| c.len() == 7 || c.len() == 5);
         assert!(shapes, "the checkpoint carries the polygons");
         assert!(p.len() > 40, "particles poured: {}", p.len());
     };
-    let (test, scene) = ("polygon_runs_resume_bitwise", polygon_scene());
-    common::assert_resumes_bitwise(common::Path::Cpu, test, &scene, 15000, 5000, check);
+    for path in common::PATHS {
+        // The GPU path does not take point sources beside layered blocks yet: it resumes
+        // the pour alone.
+        let scene = polygon_scene(path == common::Path::Cpu);
+        let test = "polygon_runs_resume_bitwise";
+        common::assert_resumes_bitwise(path, test, &scene, 15000, 5000, check);
+    }
 }
 
 /// Throughput counts the moving particles only, as other DEM codes do (issue 20: a

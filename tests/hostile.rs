@@ -29,9 +29,7 @@ fn cases(ci: usize, per_scene: f64) -> usize {
 }
 
 fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("talus-hostile-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+    common::tmp("hostile", name)
 }
 
 // ---------------------------------------------------------------------------------------
@@ -575,9 +573,8 @@ fn damaged_lengths_in_a_checkpoint_are_refused() {
 /// `talus run` on the CPU path with one thread (results are bitwise the same for any
 /// count; one leaves the other tests their cores).
 fn talus_run(args: &[&str]) -> std::process::Command {
-    let mut c = std::process::Command::new(common::talus_bin());
-    c.args(["--threads", "1", "run", "-q", "--backend", "cpu"])
-        .args(args);
+    let mut c = common::command(["--threads", "1", "run", "-q", "--backend", "cpu"]);
+    c.args(args);
     c
 }
 

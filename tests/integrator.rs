@@ -163,18 +163,30 @@ fn a_column_created_at_equilibrium_stays_there() {
     v["dt"] = json!(5e-4);
     v["gravity"] = json!({ "g": [0.0, -1.0] });
     v["walls"] = json!([{ "from": [-1.0, 0.0], "to": [1.0, 0.0] }]);
-    let mut s = sim(&v);
-    let mut worst: f64 = 0.0;
-    for _ in 0..2000 {
-        s.step().unwrap();
-        for (p, c) in s.pairs.iter().zip(&s.contacts) {
-            let above = if p.is_wall() { n } else { n - p.i as usize - 1 };
-            let exact = above as f64 / k_n;
-            worst = worst.max((c.overlap - exact).abs() / exact);
+    // The GPU path reads overlaps from f32 offsets of positions held in fixed point
+    // (issue 14): measured on lavapipe 2.5e-8 (the CPU path 1.4e-10); bounds 4-70x above.
+    for (path, bound) in [(Path::Cpu, 1e-8), (Path::Gpu, 1e-7)] {
+        let test = "a_column_created_at_equilibrium_stays_there";
+        let Some(mut e) = engine(path, test, sim(&v)) else {
+            continue;
+        };
+        let mut worst: f64 = 0.0;
+        for _ in 0..2000 {
+            e.advance(1).unwrap();
+            let s = e.sim().unwrap();
+            assert_eq!(s.pairs.len(), n, "{path:?}");
+            for (p, c) in s.pairs.iter().zip(&s.contacts) {
+                let above = if p.is_wall() { n } else { n - p.i as usize - 1 };
+                let exact = above as f64 / k_n;
+                worst = worst.max((c.overlap - exact).abs() / exact);
+            }
         }
+        eprintln!("{path:?}: overlaps left the equilibrium by {worst:.2e}");
+        assert!(
+            worst < bound,
+            "{path:?}: overlaps left the equilibrium by {worst:.2e}"
+        );
     }
-    assert_eq!(s.pairs.len(), n);
-    assert!(worst < 1e-8, "overlaps left the equilibrium by {worst:.2e}");
 }
 
 /// A grain in free fall for 2·10⁴ steps has v = g t and z = z0 − g t²/2 on both paths, to

@@ -264,7 +264,10 @@ fn leapfrog_linear_collision() {
 /// F_e = m g, for n = 36 and r0 = 1.2σ; both integrators.
 #[test]
 fn continuous_law_rests_at_one_diameter() {
-    for integrator in ["gear5", "leapfrog"] {
+    let runs = PATHS
+        .into_iter()
+        .flat_map(|p| [(p, "gear5"), (p, "leapfrog")]);
+    for (path, integrator) in runs {
         let mut v = scene_value(
             json!({ "law": "continuous", "n": 36, "r0": 1.2, "mu": 0.5 }),
             json!([{ "kind": "list", "material": "m", "particles": [
@@ -275,12 +278,15 @@ fn continuous_law_rests_at_one_diameter() {
         v["gravity"] = json!({ "g": [0.0, -1.0] });
         v["dt"] = json!(1e-3);
         v["integrator"] = json!(integrator);
-        let mut s = sim(&v);
-        for _ in 0..40_000 {
-            s.step().unwrap();
-        }
-        let r = distance(&s, 0, 1);
-        assert!((r - 1.0).abs() < 1e-6, "{integrator}: rest separation {r}");
+        let Some(mut e) = engine(path, "continuous_law_rests_at_one_diameter", sim(&v)) else {
+            continue;
+        };
+        e.advance(40_000).unwrap();
+        let r = distance(e.sim().unwrap(), 0, 1);
+        assert!(
+            (r - 1.0).abs() < 1e-6,
+            "{path:?} {integrator}: rest separation {r}"
+        );
     }
 }
 
@@ -296,18 +302,20 @@ fn equivalent_hooke_law_rests_at_its_overlap() {
     );
     v["gravity"] = json!({ "g": [0.0, -1.0] });
     v["dt"] = json!(1e-3);
-    let mut s = sim(&v);
-    for _ in 0..40_000 {
-        s.step().unwrap();
-    }
     let k = talus::law::continuous::equivalent_hooke_constant(36.0, 1.2, 0.915);
-    let r = distance(&s, 0, 1);
-    assert!(
-        (1.0 - r - 1.0 / k).abs() < 1e-6 / k * 1e3,
-        "overlap {} vs {}",
-        1.0 - r,
-        1.0 / k
-    );
+    for path in PATHS {
+        let Some(mut e) = engine(path, "equivalent_hooke_law_rests_at_its_overlap", sim(&v)) else {
+            continue;
+        };
+        e.advance(40_000).unwrap();
+        let r = distance(e.sim().unwrap(), 0, 1);
+        assert!(
+            (1.0 - r - 1.0 / k).abs() < 1e-6 / k * 1e3,
+            "{path:?}: overlap {} vs {}",
+            1.0 - r,
+            1.0 / k
+        );
+    }
 }
 
 /// Total energy (kinetic with spin + elastic with the tangential spring + potential) of a

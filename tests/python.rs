@@ -71,8 +71,7 @@ fn small_run(dir: &Path) -> PathBuf {
     let scene = dir.join("scene.json");
     std::fs::write(&scene, v.to_string()).unwrap();
     let out = dir.join("run");
-    let o = Command::new(common::talus_bin())
-        .args(["run", "-q", "--backend", "cpu", "--out"])
+    let o = common::command(["run", "-q", "--backend", "cpu", "--out"])
         .arg(&out)
         .arg(&scene)
         .output()

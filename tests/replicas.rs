@@ -150,9 +150,8 @@ fn a_run_with_copies_writes_each_as_a_run_of_its_own() {
     let dir = std::env::temp_dir().join(format!("talus-replicas-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let run = |out: &std::path::Path, set: &[&str]| {
-        let mut c = std::process::Command::new(common::talus_bin());
-        c.args(["--threads", "2", "run", "-q", "--backend", "cpu", "--out"])
-            .arg(out);
+        let mut c = common::command(["--threads", "2", "run", "-q", "--backend", "cpu", "--out"]);
+        c.arg(out);
         for s in [
             "stop.time=8",
             "particles[1].count=40",

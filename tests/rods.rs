@@ -351,17 +351,16 @@ fn rods_poured_into_a_box_settle_and_stop_by_their_mean_kinetic_energy() {
     let scene = dir.join("box.json");
     std::fs::write(&scene, v.to_string()).unwrap();
     let out = dir.join("run");
-    let status = std::process::Command::new(common::talus_bin())
-        .args([
-            "run",
-            scene.to_str().unwrap(),
-            "--out",
-            out.to_str().unwrap(),
-            "--backend",
-            "cpu",
-        ])
-        .output()
-        .unwrap();
+    let status = common::command([
+        "run",
+        scene.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--backend",
+        "cpu",
+    ])
+    .output()
+    .unwrap();
     assert!(
         status.status.success(),
         "{}",

@@ -10,8 +10,8 @@ use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
 fn talus(threads: usize, args: &[&str]) -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_talus"));
-    c.args(["--threads", &threads.to_string()]).args(args);
+    let mut c = common::command(["--threads", &threads.to_string()]);
+    c.args(args);
     c
 }
 

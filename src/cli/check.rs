@@ -2,9 +2,10 @@
 //! the GPU (`--backend gpu`), and its run time estimated (`--estimate`).
 
 use super::build_simulation;
+use super::choices::Backend;
 use super::failure::Failure;
 use std::path::PathBuf;
-use talus::gpu::device::{self, BackendChoice as Backend};
+use talus::gpu::device;
 use talus::gpu::{GpuError, GpuSimulation};
 use talus::run::Engine;
 use talus::{io::checkpoint, run, scene, sim::Simulation};

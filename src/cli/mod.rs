@@ -14,19 +14,21 @@ macro_rules! out {
 }
 mod analyze;
 mod check;
+mod choices;
 mod failure;
 mod reproduce;
 #[path = "run.rs"]
 mod run_cmd;
 mod sweep;
 
+use choices::Backend;
 use failure::Failure;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 use talus::gpu::GpuSimulation;
-use talus::gpu::device::{self, BackendChoice as Backend};
+use talus::gpu::device;
 use talus::run::Engine;
 use talus::{bench, io::checkpoint, scene, sim::Simulation};
 
@@ -110,8 +112,8 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
         /// What colours the grains.
-        #[arg(long, value_enum, default_value_t = talus::render::Field::Pressure)]
-        color: talus::render::Field,
+        #[arg(long, value_enum, default_value_t = choices::Color::Pressure)]
+        color: choices::Color,
         /// Width of the pictures in pixels.
         #[arg(long, default_value_t = 1600)]
         width: u32,
@@ -294,7 +296,7 @@ fn command(command: Command, threads: usize) -> ExitCode {
             width,
             window,
             g,
-        } => analyze::cmd_render(&path, out, color, width, window, g),
+        } => analyze::cmd_render(&path, out, color.into(), width, window, g),
         Command::Reproduce {
             id,
             full,
@@ -575,8 +577,9 @@ fn cmd_bench(
         (Some(n), None) => (n, None),
         (n, b) => (n.unwrap_or(100_000), Some(b.unwrap_or(DEFAULT_BUDGET))),
     };
+    let backends: Vec<device::BackendChoice> = backends.iter().map(|&b| b.into()).collect();
     let report = bench::run(
-        backends,
+        &backends,
         sizes,
         polygon_sizes,
         rod_sizes,

@@ -1,13 +1,13 @@
 //! `talus reproduce`: a paper's scene run as its variants (or as sweeps over seeds),
 //! measured, drawn and judged in reproduce.json.
 
+use super::choices::Backend;
 use super::failure::Failure;
 use super::sweep::run_here;
 use super::{choose_engine, degrees, on_interrupt};
 use clap::ValueEnum;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
-use talus::gpu::device::BackendChoice as Backend;
 use talus::sweep;
 use talus::{io::checkpoint, run, scene, sim::Simulation};
 

@@ -2,11 +2,11 @@
 //! next stage of a multi-stage run (`--from`: the state of an earlier run under a new
 //! scene); then the final state measured and drawn.
 
+use super::choices::Backend;
 use super::failure::Failure;
 use super::{build_simulation, choose_engine, load_scene, measure_and_draw, on_interrupt};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
-use talus::gpu::device::BackendChoice as Backend;
 use talus::{io::checkpoint, run};
 
 /// What `talus run` was asked.

@@ -3,6 +3,7 @@
 //! run (what an array task calls), `collect` the statistics (`talus::sweep::collect`).
 //! The plan, the folders and the statistics are the library's (`talus::sweep`).
 
+use super::choices::Backend;
 use super::failure::Failure;
 use super::{choose_engine, on_interrupt};
 use clap::ValueEnum;
@@ -11,7 +12,6 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-use talus::gpu::device::BackendChoice as Backend;
 use talus::sweep::{self, Plan, RunState, slurm::SlurmOptions};
 use talus::{io::checkpoint, run, sim::Simulation};
 

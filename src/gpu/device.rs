@@ -8,7 +8,7 @@
 use std::fmt::Write as _;
 
 /// Which path a run uses (`--backend`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BackendChoice {
     /// A GPU adapter when one exists, else the CPU path with a notice.
     Auto,
@@ -239,20 +239,6 @@ impl Gpu {
     /// The most bytes one buffer may hold and be bound.
     pub fn binding_limit(&self) -> u64 {
         binding_limit(&self.limits)
-    }
-
-    /// Checks a buffer of `bytes` against the device limits before allocating it.
-    pub fn check_buffer(&self, what: &str, bytes: u64) -> Result<(), DeviceError> {
-        let max = self.binding_limit();
-        if bytes > max {
-            return Err(DeviceError::TooLarge {
-                name: self.info.name.clone(),
-                reason: format!(
-                    "the {what} buffer needs {bytes} bytes and the adapter binds at most {max}"
-                ),
-            });
-        }
-        Ok(())
     }
 }
 

@@ -23,8 +23,8 @@ pub const COPY_SHIFT: u32 = 20;
 
 /// A particle's `Props.flags`.
 pub fn flags(active: bool, fixed: bool, material: u32, copy: u32) -> u32 {
-    (active as u32) * ACTIVE
-        | (fixed as u32) * FIXED
+    ((active as u32) * ACTIVE)
+        | ((fixed as u32) * FIXED)
         | (material << MATERIAL_SHIFT)
         | (copy << COPY_SHIFT)
 }

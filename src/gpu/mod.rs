@@ -38,6 +38,7 @@ pub mod modules;
 pub mod orientation;
 mod params;
 pub mod position;
+mod probe;
 mod profile;
 mod readback;
 mod step;

@@ -1,5 +1,5 @@
 //! Readback of the device state into the host mirror (`download`, `device_state`),
-//! uploads of lists and springs, and the access the tests of single kernels use.
+//! and the device's contacts read back for the host's contact list.
 
 use super::transfer::*;
 use super::*;
@@ -62,13 +62,6 @@ impl GpuSimulation {
     /// run loop asks before it uses a read (issue 16 item 8: no panic on a lost device).
     pub fn failure(&self) -> Option<GpuError> {
         self.gpu.failure().map(GpuError::Readback)
-    }
-
-    /// Destroys the device, as a driver reset or an unplugged GPU would (tests: a run
-    /// must stop with an error, not a panic).
-    #[doc(hidden)]
-    pub fn destroy_device_for_test(&self) {
-        self.gpu.device.destroy();
     }
 
     /// Where a `map_async` callback leaves its outcome for the thread that polled.
@@ -283,61 +276,6 @@ impl GpuSimulation {
             (control::LISTS * 4) as u64,
             bytemuck::bytes_of(&flags),
         );
-    }
-
-    /// Sets the neighbour lists' word (`control::REBUILD`, …; tests of single kernels).
-    pub fn set_list_flags(&mut self, flags: u32) {
-        self.write_lists_word(flags);
-        self.synced = false;
-    }
-
-    /// Overwrites the spring table (tests); the next rebuild takes its springs from it.
-    pub fn upload_springs(&mut self, entries: &[Entry]) {
-        let table = build_table(entries, self.params.table_mask as usize + 1);
-        let buf = self.buffers.table.clone();
-        self.write_buffer(&buf, &table);
-        self.set_list_flags(control::REBUILD | control::TABLE_CURRENT);
-    }
-
-    /// Overwrites the lists and their springs, every candidate touching (tests).
-    pub fn upload_contacts(&mut self, count: &[u32], js: &[u32], history: &[f32]) {
-        let (a, b, c, d) = (
-            self.buffers.contact_count.clone(),
-            self.buffers.contact_j.clone(),
-            self.buffers.hist_in.clone(),
-            self.buffers.touching.clone(),
-        );
-        self.write_buffer(&a, count);
-        self.write_buffer(&b, js);
-        self.write_buffer(&c, history);
-        self.write_buffer(&d, &vec![1u32; js.len()]);
-    }
-
-    pub fn upload_cell_counts(&mut self, counts: &[u32]) {
-        let buf = self.buffers.cell_count.clone();
-        self.write_buffer(&buf, counts);
-    }
-
-    /// Reads a buffer, by the name of its WGSL variable, as u32 words (tests).
-    pub fn read_u32(&self, name: &str, count: usize) -> Vec<u32> {
-        let buf = self
-            .buffers
-            .named(name)
-            .unwrap_or_else(|| panic!("unknown buffer {name}"));
-        self.read_buffer(buf, 0, count)
-    }
-
-    /// Reads a buffer, by the name of its WGSL variable, as f32 words (tests).
-    pub fn read_f32(&self, name: &str, count: usize) -> Vec<f32> {
-        let buf = self
-            .buffers
-            .named(name)
-            .unwrap_or_else(|| panic!("unknown buffer {name}"));
-        self.read_buffer(buf, 0, count)
-    }
-
-    pub fn read_forces(&self, count: usize) -> Vec<[f32; 4]> {
-        self.read_buffer(&self.buffers.force, 0, count)
     }
 
     pub fn read_contact_out(&self, count: usize) -> Vec<ContactOut> {

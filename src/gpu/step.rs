@@ -214,39 +214,6 @@ impl GpuSimulation {
         self.mark_kernel(pass, k);
     }
 
-    /// Runs one kernel with a given number of workgroups (tests of the grid-stride
-    /// loops, which must cover everything from any number of workgroups).
-    pub fn run_kernel_with_groups(&mut self, k: Kernel, groups: u64) {
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            self.mark_start(&mut pass);
-            self.dispatch(&mut pass, k, groups);
-        }
-        self.gpu.queue.submit([enc.finish()]);
-        self.synced = false;
-    }
-
-    /// Runs some kernels once, in order, in one submission (tests of single stages), as
-    /// in a step recorded with the rebuild stages (`STAGE_EVERY`): nothing pauses.
-    pub fn run_kernels(&mut self, ks: &[Kernel]) {
-        self.gpu.queue.write_buffer(
-            &self.buffers.control,
-            (control::STAGED * 4) as u64,
-            bytemuck::bytes_of(&1u32),
-        );
-        let mut enc = self.gpu.device.create_command_encoder(&Default::default());
-        {
-            let mut pass = enc.begin_compute_pass(&Default::default());
-            self.mark_start(&mut pass);
-            for &k in ks {
-                self.encode_kernel(&mut pass, k);
-            }
-        }
-        self.gpu.queue.submit([enc.finish()]);
-        self.synced = false;
-    }
-
     /// The kernels of the cell list, in order.
     pub const CELL_LIST: [Kernel; 8] = [
         Kernel::ClearCells,

@@ -64,7 +64,7 @@ impl Hint {
     pub const NONE: Hint = Hint(0);
 
     pub fn apart(of_q: bool, edge: usize, corner: usize) -> Hint {
-        Hint(1 + of_q as u32 | (edge as u32) << 2 | (corner as u32) << 6)
+        Hint((1 + of_q as u32) | ((edge as u32) << 2) | (corner as u32) << 6)
     }
 
     pub fn resting(c: Chain) -> Hint {

@@ -44,7 +44,7 @@ impl RenderError {
 }
 
 /// What colours the grains.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Field {
     /// The grain's own pressure, (σ_max + σ_min)/2 of Σ f ⊗ l over its area.
     Pressure,

@@ -173,10 +173,10 @@ pub struct SeedAverage {
 pub fn seed_averages(found: &[Findings]) -> Vec<SeedAverage> {
     let mut settings: Vec<String> = Vec::new();
     for f in found {
-        if let Some((setting, _)) = f.variant.split_once("-seed") {
-            if !settings.iter().any(|s| s == setting) {
-                settings.push(setting.to_string());
-            }
+        if let Some((setting, _)) = f.variant.split_once("-seed")
+            && !settings.iter().any(|s| s == setting)
+        {
+            settings.push(setting.to_string());
         }
     }
     settings

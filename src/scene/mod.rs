@@ -80,18 +80,17 @@ pub fn parse(text: &str, overrides: &[String]) -> Result<Scene, SceneError> {
         apply_override(&mut value, o)?;
     }
     let mut scene = from_value(value)?;
-    validate(&scene)?;
-    resolve_materials(&mut scene)?;
+    let checked = validate::check(&scene)?;
+    resolve_materials(&mut scene, &checked.law);
     Ok(scene)
 }
 
 /// Records what the material form resolved (`contact.resolved`, src/law/restitution.rs),
 /// so that the run's `scene.json` says which k and γ per unit mass each pair got. Never an
 /// input: a `resolved` block read back is replaced by the values computed anew.
-fn resolve_materials(scene: &mut Scene) -> Result<(), SceneError> {
-    let law = crate::law::ContactLaw::of_scene(scene)?;
+fn resolve_materials(scene: &mut Scene, law: &crate::law::ContactLaw) {
     let names: Vec<String> = scene.materials.keys().cloned().collect();
-    match (&mut scene.contact, &law) {
+    match (&mut scene.contact, law) {
         (ContactSpec::SpringDashpot(spec), crate::law::ContactLaw::SpringDashpot(l)) => {
             spec.resolved = l.resolved(&names);
         }
@@ -100,7 +99,6 @@ fn resolve_materials(scene: &mut Scene) -> Result<(), SceneError> {
         }
         _ => {}
     }
-    Ok(())
 }
 
 /// Strict typed parse of a JSON value; errors carry the key path. An array where the

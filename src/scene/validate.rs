@@ -133,11 +133,23 @@ fn polygons(scene: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// Checks every value; returns warnings that do not stop a run.
 /// The most copies a scene may ask for (`replicas`).
 pub const MAX_REPLICAS: u32 = 4096;
 
+/// Checks every value; returns warnings that do not stop a run.
 pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
+    check(scene).map(|c| c.warnings)
+}
+
+/// What checking a scene found: its contact law, built once here from the scene's
+/// `contact` block (`scene::parse` records its resolved pairs with it), and the warnings.
+pub(super) struct Checked {
+    pub law: ContactLaw,
+    pub warnings: Vec<String>,
+}
+
+/// [`validate`], keeping the law it built.
+pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
     let mut warnings = Vec::new();
     // Without --out the name is the output folder (runs/<name>): a path in it would
     // write anywhere (issue 16).
@@ -387,7 +399,7 @@ pub fn validate(scene: &Scene) -> Result<Vec<String>, SceneError> {
     let law = ContactLaw::of_scene(scene)?;
     spheropolygons(scene, &law)?;
     warnings.extend(super::stability::time_step(scene, &law)?);
-    Ok(warnings)
+    Ok(Checked { law, warnings })
 }
 
 /// Rods (spheropolygons) and law `hertz_cohesive` go together (issue 15): rods need the

@@ -5,6 +5,7 @@ use serde_json::{Value, json};
 use talus::scene::{self, Scene};
 use talus::sim::Simulation;
 
+pub mod cli;
 pub mod mutate;
 pub mod pairs;
 pub mod resume;
@@ -12,14 +13,9 @@ pub mod vtp;
 pub mod wgsl;
 
 #[allow(unused_imports)] // each test binary uses some
+pub use cli::{command, talus, talus_bin, talus_ok, tmp};
+#[allow(unused_imports)]
 pub use resume::{assert_resumes_bitwise, assert_same_state, carries_sub_springs};
-
-/// The talus binary that tests start: `TALUS_BIN` when set (`scripts/gpu-check` runs
-/// test binaries staged without cargo's target folder, beside a staged talus), else the
-/// one cargo built with the tests.
-pub fn talus_bin() -> std::path::PathBuf {
-    std::env::var_os("TALUS_BIN").map_or_else(|| env!("CARGO_BIN_EXE_talus").into(), Into::into)
-}
 
 /// A scene around `particles` and `contact`, with a large domain, no gravity by default.
 pub fn scene_value(contact: Value, particles: Value) -> Value {
