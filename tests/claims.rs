@@ -119,6 +119,38 @@ fn reproduce_r9_packing_falls_with_the_aspect_ratio_and_with_cohesion() {
 }
 
 #[test]
+fn reproduce_r2_full_stiff_piles_dip_alike_for_both_squeezes() {
+    // R2 --full adds both squeezes at k_n = 10⁶ and 10⁷ N/m (issue 40 item 4): there the
+    // overlaps under gravity are far below the squeeze of either c, row 1 jams fully,
+    // and both dip alike (28-30 % measured), unlike at 10⁵ N/m where the dip deepens
+    // with |c| (the claim above).
+    let (_, report) = reproduce("reproduce-r2-stiff", &["R2", "--full", "--only", "kn="]);
+    let names: Vec<&str> = (report["variants"].as_array().unwrap().iter())
+        .map(|v| v["variant"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        names,
+        [
+            "c=-1_750-kn=1e6",
+            "c=-1_150-kn=1e6",
+            "c=-1_750-kn=1e7",
+            "c=-1_150-kn=1e7"
+        ]
+    );
+    let dip = |name: &str| variant(&report, name)["row1_dip"].as_f64().unwrap();
+    for k_n in ["1e6", "1e7"] {
+        let (light, strong) = (
+            dip(&format!("c=-1_750-kn={k_n}")),
+            dip(&format!("c=-1_150-kn={k_n}")),
+        );
+        assert!(
+            light > 0.2 && strong > 0.2 && (light - strong).abs() < 0.05,
+            "k_n = {k_n}: dips {light} (c = -1/750) and {strong} (c = -1/150)"
+        );
+    }
+}
+
+#[test]
 fn reproduce_r2_dips_under_a_squeezed_bottom_only() {
     // R2 (paper 000 sec. 4.1, Fig. 3a), L1 = 19: the pile starts without overlaps and
     // S_zz(1) under the apex is the maximum for c = 0 (a hump), flat for c = −1/750, and
@@ -133,6 +165,15 @@ fn reproduce_r2_dips_under_a_squeezed_bottom_only() {
     }
     for v in [&flat, &light, &strong] {
         assert_eq!(v["grains"], 92, "no grain is lost: {v}");
+        // Each run's cost, from its summary (issue 40 item 6).
+        let cost = &v["cost"];
+        assert!(
+            cost["steps"].as_u64().unwrap() > 1000
+                && cost["wall_seconds"].as_f64().unwrap() > 0.0
+                && cost["particle_steps_per_second"].as_f64().unwrap() > 0.0
+                && cost["backend"] == "cpu",
+            "{cost}"
+        );
     }
     let f = |v: &Value, k: &str| v[k].as_f64().unwrap();
     assert_eq!(

@@ -458,6 +458,63 @@ fn the_repose_picture_keys_each_reading_with_its_angles() {
     }
 }
 
+/// The paper's angle (`talus reproduce`, issue 40 item 5) is drawn beside talus's: a
+/// fifth key entry "source: value ± spread" spelled in its colour, and dashed lines
+/// from the apex down to the base at that angle on both flanks.
+#[test]
+fn the_papers_angle_is_drawn_from_the_apex_and_keyed_with_its_source() {
+    let a = column("reduced");
+    let dir = tmp("repose-paper");
+    let marks = render::PaperMarks {
+        repose_deg: Some(render::PaperNumber {
+            value: 35.0,
+            spread: Some(5.0),
+            source: "paper 001 (Fig. 1)".into(),
+        }),
+    };
+    render::render_marked(&a, &dir, Field::Pressure, WIDTH, &marks).unwrap();
+    let svg = std::fs::read_to_string(dir.join("repose.svg")).unwrap();
+    let words = texts(&group(&svg, "line-key"));
+    let values: Vec<&Text> = words.iter().filter(|t| t.class == "value").collect();
+    assert_eq!(values.len(), 5, "four readings and the paper's");
+    assert_eq!(values[4].words, "paper 001 (Fig. 1): 35 ± 5");
+    let green = [0, 140, 70];
+    let png = Pixmap::load_png(dir.join("repose.png")).unwrap();
+    assert_spelled(&png, values[4], green);
+    // The dashes, in picture coordinates: each runs at 35° to the horizontal, and
+    // together they reach from the apex to the base on both sides of it.
+    let stroke = "stroke=\"rgb(0,140,70)\"";
+    let dashes: Vec<[f64; 4]> = (svg.lines())
+        .filter(|l| l.starts_with("<line") && l.contains(stroke))
+        .map(|l| ["x1", "y1", "x2", "y2"].map(|k| num(l, k)))
+        .collect();
+    assert!(dashes.len() >= 4, "dashed: {} pieces", dashes.len());
+    for d in &dashes {
+        let angle = ((d[3] - d[1]).abs() / (d[2] - d[0]).abs())
+            .atan()
+            .to_degrees();
+        assert!((angle - 35.0).abs() < 0.5, "a dash at {angle}°");
+    }
+    // Both flanks from one apex: as wide as 2 / tan 35° times as high (to a dash).
+    let xs = dashes.iter().flat_map(|d| [d[0], d[2]]);
+    let ys = dashes.iter().flat_map(|d| [d[1], d[3]]);
+    let span = |v: Vec<f64>| {
+        v.iter().fold(f64::NEG_INFINITY, |m, &x| m.max(x))
+            - v.iter().fold(f64::INFINITY, |m, &x| m.min(x))
+    };
+    let (wide, high) = (span(xs.collect()), span(ys.collect()));
+    let want = 2.0 / 35f64.to_radians().tan();
+    assert!(
+        (wide / high / want - 1.0).abs() < 0.15,
+        "{wide} wide, {high} high"
+    );
+    // Without marks no such line is drawn (the test above counts four entries).
+    let plain =
+        std::fs::read_to_string(draw(&a, Field::Pressure, "repose-plain").join("repose.svg"))
+            .unwrap();
+    assert!(!plain.contains(stroke));
+}
+
 /// A pressure of both signs (the top grain pulled up by cohesion) is drawn on the
 /// diverging map, symmetric about zero: red for tension, white for none, blue for
 /// compression, its zero marked under the bar.

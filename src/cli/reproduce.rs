@@ -123,14 +123,16 @@ pub(super) fn cmd_reproduce(
         let input = talus::analyze::input::load(&dir, None)?;
         let a = talus::analyze::analyze(input, &opt)?;
         talus::analyze::write(&a, &dir.join("analysis"))?;
-        talus::render::render(
+        talus::render::render_marked(
             &a,
             &dir.join("pictures"),
             talus::render::Field::Pressure,
             1600,
+            &reproduce::paper::marks(&id, &v.name),
         )?;
         talus::render::vtk::write(&a, &dir.join("pictures"))?;
-        let f = reproduce::findings(&v.name, &a);
+        let mut f = reproduce::findings(&v.name, &a);
+        f.cost = reproduce::RunCost::of_run(&dir);
         out!(
             "{id} {}: {} grains, t = {:.3}; repose {} / {}; S_xx/S_zz (row 1, interior) {:.3}; S_zz under the apex / max: base {:.3} / {:.3} (dip {:.2}), row 1 {:.3} / {:.3} (dip {:.2}); Z interior {:.2}",
             v.name,
@@ -156,6 +158,17 @@ pub(super) fn cmd_reproduce(
                 "{id} {}: load on the base particles (over {} of them) under the apex {c:.2} m g, largest left {l:.2}, right {r:.2}",
                 v.name,
                 talus::analyze::BASE_SPAN
+            );
+        }
+        if let Some(c) = &f.cost {
+            out!(
+                "{id} {}: {} steps in {:.1} s ({:.3e} particle-steps/s, {} thread(s), {})",
+                v.name,
+                c.steps,
+                c.wall_seconds,
+                c.particle_steps_per_second,
+                c.threads,
+                c.backend
             );
         }
         found.push(f);

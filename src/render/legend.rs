@@ -329,33 +329,36 @@ pub(super) fn arm_key(
     c.svg.push_str("</g>\n");
 }
 
-/// A key of coloured lines: a short stroke in each colour and its text after it, two
-/// columns of two rows under `label`, the second column after the first's longest text.
+/// A key of coloured lines: a short stroke in each colour and its text after it, in
+/// columns of two rows under `label`, each column after the previous one's longest text.
 pub(super) fn line_key(c: &mut Canvas, label: &str, entries: &[([u8; 3], String)]) {
     let s = Strip::of(c);
     if s.x1 <= s.x0 + 1 {
         return;
     }
-    let first = (entries.iter().take(2))
-        .map(|e| text::width(&e.1, s.k))
-        .max()
-        .unwrap_or(0);
-    let second = (entries.iter().skip(2))
-        .map(|e| text::width(&e.1, s.k))
-        .max()
-        .unwrap_or(0);
-    let column = 7 * s.u / 2 + first;
+    // A column: the stroke and its gap (5u/2), the longest text, u to the next column.
+    let texts: Vec<u32> = (entries.chunks(2))
+        .map(|pair| (pair.iter().map(|e| text::width(&e.1, s.k)).max()).unwrap_or(0))
+        .collect();
+    let total = texts
+        .iter()
+        .map(|w| 7 * s.u / 2 + w)
+        .sum::<u32>()
+        .saturating_sub(s.u);
     // Ending at the strip's right edge when it is longer than the right half (a narrow
     // picture), so that no text is clipped.
-    let x0 = s.x0.min(s.x1.saturating_sub(column + 5 * s.u / 2 + second));
+    let x0 = s.x0.min(s.x1.saturating_sub(total));
     let thick = (s.u / 4).max(2);
     c.svg.push_str("<g id=\"line-key\">\n");
     c.text(s.x1, s.label_y, label, Anchor::End, INK, "label");
-    for (k, (colour, text)) in entries.iter().enumerate().take(4) {
-        let x = x0 + (k as u32 / 2) * column;
-        let y = if k % 2 == 0 { s.bar_y } else { s.numbers_y };
-        c.rect(x, y + s.u / 2 - thick / 2, 2 * s.u, thick, *colour);
-        c.text(x + 5 * s.u / 2, y, text, Anchor::Start, *colour, "value");
+    let mut x = x0;
+    for (pair, width) in entries.chunks(2).zip(&texts) {
+        for (k, (colour, text)) in pair.iter().enumerate() {
+            let y = if k == 0 { s.bar_y } else { s.numbers_y };
+            c.rect(x, y + s.u / 2 - thick / 2, 2 * s.u, thick, *colour);
+            c.text(x + 5 * s.u / 2, y, text, Anchor::Start, *colour, "value");
+        }
+        x += 7 * s.u / 2 + width;
     }
     c.svg.push_str("</g>\n");
 }

@@ -363,6 +363,17 @@ impl Canvas {
             .stroke_path(&path, &paint, &st, Transform::identity(), None);
     }
 
+    /// A dashed line from a to b: dashes and gaps `dash` long (world units).
+    fn dashed(&mut self, a: (f64, f64), b: (f64, f64), width: f32, color: [u8; 3], dash: f64) {
+        let length = (b.0 - a.0).hypot(b.1 - a.1);
+        let pieces = (length / dash).floor().max(1.0) as usize;
+        let at = |t: f64| (a.0 + t * (b.0 - a.0), a.1 + t * (b.1 - a.1));
+        for k in (0..pieces).step_by(2) {
+            let (t0, t1) = (k as f64 / pieces as f64, (k + 1) as f64 / pieces as f64);
+            self.line(at(t0), at(t1), width, color);
+        }
+    }
+
     fn save(mut self, dir: &Path, stem: &str, files: &mut Vec<PathBuf>) -> Result<(), RenderError> {
         self.svg.push_str("</svg>\n");
         let png = self
@@ -385,6 +396,34 @@ const TENSION: [u8; 3] = [200, 40, 40];
 const MIDDLE: [u8; 3] = [30, 90, 210];
 const APEX_TOE: [u8; 3] = [230, 130, 0];
 const STEEPEST: [u8; 3] = [200, 30, 120];
+/// The papers' numbers drawn beside talus's.
+const PAPER: [u8; 3] = [0, 140, 70];
+
+/// A number a paper reports, drawn beside talus's own (issue 40 item 5): its value, the
+/// spread the paper gives with it, and where in the paper it is.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PaperNumber {
+    pub value: f64,
+    pub spread: Option<f64>,
+    pub source: String,
+}
+
+impl PaperNumber {
+    /// "source: value ± spread", as the keys show it.
+    pub fn label(&self) -> String {
+        match self.spread {
+            Some(s) => format!("{}: {} ± {}", self.source, self.value, s),
+            None => format!("{}: {}", self.source, self.value),
+        }
+    }
+}
+
+/// The papers' numbers that the pictures draw beside talus's (`talus reproduce`): the
+/// angle of repose, in degrees, as lines from the apex.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PaperMarks {
+    pub repose_deg: Option<PaperNumber>,
+}
 
 /// Writes every picture of `a` into `dir`; `width` is the pictures' width in pixels.
 pub fn render(
@@ -392,6 +431,18 @@ pub fn render(
     dir: &Path,
     field: Field,
     width: u32,
+) -> Result<Vec<PathBuf>, RenderError> {
+    render_marked(a, dir, field, width, &PaperMarks::default())
+}
+
+/// [`render`], with the papers' numbers drawn beside talus's where a picture has room
+/// for them.
+pub fn render_marked(
+    a: &Analysis,
+    dir: &Path,
+    field: Field,
+    width: u32,
+    marks: &PaperMarks,
 ) -> Result<Vec<PathBuf>, RenderError> {
     std::fs::create_dir_all(dir).map_err(RenderError::write(dir))?;
     let mut files = Vec::new();
@@ -503,7 +554,7 @@ pub fn render(
     legend::length_scale(&mut c, &a.input.length_unit);
     legend::caption(&mut c, &a.input);
     c.save(dir, "stress_crosses", &mut files)?;
-    repose_lines(a, view, line)?.save(dir, "repose", &mut files)?;
+    repose_lines(a, view, line, marks)?.save(dir, "repose", &mut files)?;
     files.extend(plots::write_plots(a, dir)?);
     Ok(files)
 }
@@ -511,8 +562,13 @@ pub fn render(
 /// The angle of repose as each rule reads it (`analyze::heap::Readings`): the surface
 /// points (the band's fitted ones dark), and the lines of the band fit, the middle
 /// third, apex to toe and the steepest stretch over faint grains, each flank's angle
-/// in the key.
-fn repose_lines(a: &Analysis, view: View, line: f32) -> Result<Canvas, RenderError> {
+/// in the key; and the paper's angle, when given, dashed from the apex down to the base.
+fn repose_lines(
+    a: &Analysis,
+    view: View,
+    line: f32,
+    marks: &PaperMarks,
+) -> Result<Canvas, RenderError> {
     let mut c = Canvas::new(view)?;
     for g in &a.input.grains {
         let fill = if g.fixed {
@@ -547,6 +603,16 @@ fn repose_lines(a: &Analysis, view: View, line: f32) -> Result<Canvas, RenderErr
         };
         let (l, r) = (flanks[0].angle_deg, flanks[1].angle_deg);
         key.push((colour, format!("{name} {}/{}", deg(l), deg(r))));
+    }
+    if let Some(p) = &marks.repose_deg {
+        let o = &s.outline;
+        let run = o.height / p.value.to_radians().tan();
+        let dash = a.summary.mean_diameter;
+        for side in [-1.0, 1.0] {
+            let toe = (o.apex_x + side * run, o.base);
+            c.dashed((o.apex_x, o.top), toe, 1.5 * line, PAPER, dash);
+        }
+        key.push((PAPER, p.label()));
     }
     legend::length_scale(&mut c, &a.input.length_unit);
     legend::caption(&mut c, &a.input);

@@ -51,6 +51,36 @@ pub struct Findings {
     /// its maxima and minima stand out. Bins with fewer than `Q_PAIRS` pairs are left out.
     pub q_contact: Option<f64>,
     pub q_order: Option<f64>,
+    /// What the run cost, from its summary.json (issue 40 item 6); None where the run's
+    /// summary was not read (a sweep's measures).
+    pub cost: Option<RunCost>,
+}
+
+/// A run's cost as its summary.json records it: wall-clock seconds, steps, the moving
+/// particles' steps per second, and on what it ran.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunCost {
+    pub wall_seconds: f64,
+    pub steps: u64,
+    pub particle_steps_per_second: f64,
+    pub threads: u64,
+    pub backend: String,
+}
+
+impl RunCost {
+    /// The cost recorded in a run folder's summary.json; None when it is missing or
+    /// lacks a field.
+    pub fn of_run(dir: &std::path::Path) -> Option<RunCost> {
+        let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+        let s: serde_json::Value = serde_json::from_str(&text).ok()?;
+        Some(RunCost {
+            wall_seconds: s["wall_seconds"].as_f64()?,
+            steps: s["steps"].as_u64()?,
+            particle_steps_per_second: s["particle_steps_per_second"].as_f64()?,
+            threads: s["provenance"]["threads"].as_u64()?,
+            backend: s["backend"].as_str()?.to_string(),
+        })
+    }
 }
 
 /// Pairs a bin of Q(r) needs to count in `Findings::q_contact` and `q_order`.
@@ -135,6 +165,7 @@ pub fn findings(variant: &str, a: &Analysis) -> Findings {
             let q: Vec<f64> = q_bins(&a.correlation).map(f64::abs).collect();
             (!q.is_empty()).then(|| q.iter().sum::<f64>() / q.len() as f64)
         },
+        cost: None,
     }
 }
 

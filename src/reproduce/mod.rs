@@ -5,9 +5,10 @@
 use serde::Serialize;
 
 mod findings;
+pub mod paper;
 mod variants;
 pub use findings::{
-    Comparison, Findings, Q_PAIRS, SeedAverage, comparisons, findings, seed_averages,
+    Comparison, Findings, Q_PAIRS, RunCost, SeedAverage, comparisons, findings, seed_averages,
 };
 pub use variants::variants;
 
@@ -227,6 +228,7 @@ mod tests {
             vertical_stress_fraction: 0.0,
             q_contact: None,
             q_order: None,
+            cost: None,
         }
     }
 
