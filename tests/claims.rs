@@ -309,14 +309,35 @@ fn reproduce_r8_gives_the_same_stress_for_every_friction() {
     // μ = 0 and the frictional two, 0.1 % between those), and no clear dip (under 5 % in
     // the base row and row 1 for every μ; measured 0). A stress that moved with μ as much
     // as R2's does with the bottom (18–28 % under the apex) fails both.
+    // Built layer by layer as the paper builds it (issue 40 item 3), friction acts while
+    // the rows land: the profiles differ more (measured: 6.9 % at most between μ = 0 and
+    // 0.6, 1.1-1.8 % on average) but stay alike in magnitude and shape, the paper's
+    // "similar in magnitude and shape" with "much stronger" fluctuations: within 10 % at
+    // most and 3 % on average.
     let (_, report) = reproduce("reproduce-r8", &["R8", "--threads", "2"]);
     let comparisons = report["comparisons"].as_array().unwrap();
-    assert_eq!(comparisons.len(), 3, "three pairs of μ");
+    assert_eq!(comparisons.len(), 6, "three pairs of μ per construction");
     for c in comparisons {
-        let d = c["row1_szz_max_difference"].as_f64().unwrap();
-        assert!(d < 0.06, "{}: S_zz(1) differs by {d:.3}", c["variants"]);
+        let (most, mean) = (
+            c["row1_szz_max_difference"].as_f64().unwrap(),
+            c["row1_szz_mean_difference"].as_f64().unwrap(),
+        );
+        let layered = c["variants"][0].as_str().unwrap().starts_with("layered-");
+        let bound = if layered { (0.10, 0.03) } else { (0.06, 0.03) };
+        assert!(
+            most < bound.0 && mean < bound.1,
+            "{}: S_zz(1) differs by {most:.3} at most, {mean:.3} on average",
+            c["variants"]
+        );
     }
-    for mu in ["mu-0", "mu-0.3", "mu-0.6"] {
+    for mu in [
+        "mu-0",
+        "mu-0.3",
+        "mu-0.6",
+        "layered-mu-0",
+        "layered-mu-0.3",
+        "layered-mu-0.6",
+    ] {
         let v = variant(&report, mu);
         for dip in ["base_dip", "row1_dip"] {
             let d = v[dip].as_f64().unwrap();

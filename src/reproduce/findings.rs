@@ -284,15 +284,17 @@ pub struct Comparison {
     pub stress_ratio_interior_row1: [f64; 2],
 }
 
-/// The comparisons reproduction `id` is judged by: every pair of its variants for R1
-/// and R8, none for the others.
+/// The comparisons reproduction `id` is judged by: every pair of its variants built the
+/// same way for R1 and R8 (R8's `mu-…` with each other, its `layered-mu-…` with each
+/// other), none for the others.
 pub fn comparisons(id: &str, found: &[Findings]) -> Vec<Comparison> {
     if !matches!(id, "R1" | "R8") {
         return Vec::new();
     }
+    let built = |f: &Findings| f.variant.rsplit_once("mu-").map(|(b, _)| b.to_string());
     let mut out = Vec::new();
     for (i, a) in found.iter().enumerate() {
-        for b in &found[i + 1..] {
+        for b in found[i + 1..].iter().filter(|b| built(b) == built(a)) {
             let max = a
                 .row1_profile
                 .iter()

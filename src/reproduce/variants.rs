@@ -20,6 +20,8 @@ const R8: &str = include_str!("../../scenes/r8_polygon_pile.json");
 /// Grains per second of the R7 wedge sources (one every 0.075 s, as in R6).
 const R7_RATE: f64 = 40.0 / 3.0;
 const R8_REDUCED: &str = include_str!("../../scenes/r8_polygon_pile_reduced.json");
+const R8_LAYERED: &str = include_str!("../../scenes/r8_polygon_pile_layered.json");
+const R8_LAYERED_REDUCED: &str = include_str!("../../scenes/r8_polygon_pile_layered_reduced.json");
 const R9_REDUCED: &str = include_str!("../../scenes/r9_rods_reduced.json");
 
 fn v(name: &str, scene: &'static str, overrides: &[&str], window: f64, row: f64) -> Variant {
@@ -249,20 +251,32 @@ pub fn variants(id: &str, size: Size) -> Result<Vec<Variant>, ReproductionError>
             r7("wedge-poly", R7_POLY),
             r7("layered-medium", R7_LAYERED),
         ],
-        "R8" => ["0", "0.3", "0.6"]
-            .iter()
-            .map(|mu| {
-                let mut x = v(
-                    &format!("mu-{mu}"),
-                    if full { R8 } else { R8_REDUCED },
-                    &[],
-                    if full { 14.0 } else { 6.0 },
-                    LATTICE_ROW,
-                );
-                x.overrides = vec![format!("contact.mu={mu}")];
-                x
-            })
-            .collect(),
+        // The pile created whole on its lattice and settled (`mu-…`), and built as paper
+        // 000 sec. 5.2 builds it, layer by layer onto the fixed bottom row
+        // (`layered-mu-…`: rows of the lattice dropped 0.2 d every 0.05 s, then relaxed),
+        // so that friction acts while it is built.
+        "R8" => {
+            let (whole, layered) = if full {
+                (R8, R8_LAYERED)
+            } else {
+                (R8_REDUCED, R8_LAYERED_REDUCED)
+            };
+            let mut out = Vec::new();
+            for (prefix, scene) in [("", whole), ("layered-", layered)] {
+                for mu in ["0", "0.3", "0.6"] {
+                    let mut x = v(
+                        &format!("{prefix}mu-{mu}"),
+                        scene,
+                        &[],
+                        if full { 14.0 } else { 6.0 },
+                        LATTICE_ROW,
+                    );
+                    x.overrides = vec![format!("contact.mu={mu}")];
+                    out.push(x);
+                }
+            }
+            out
+        }
         // R9 (paper 004): rods of aspect d poured into a box 20 d wide. Reduced: 300 rods
         // per run, d ∈ {2, 5, 10} at Bo = 0, Bo ∈ {10², 10³, 10⁴} at d = 5, d = 2 at
         // Bo = 10³ and d = 10 at Bo = 10⁴. Full: the
