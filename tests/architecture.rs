@@ -462,3 +462,32 @@ fn only_the_binary_names_clap() {
     }
     assert!(named.is_empty(), "clap named in the library: {named:?}");
 }
+
+/// Each contact law's `evaluate` names its WGSL twin (issue 42 item 1: a law and its
+/// twin side by side), and the twin is a function of shaders/laws.wgsl that takes a
+/// `ContactInput` and gives a `ContactOutput`, as the Rust one does.
+#[test]
+fn every_law_names_its_wgsl_twin_and_the_twin_exists() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let wgsl = std::fs::read_to_string(root.join("shaders/laws.wgsl")).unwrap();
+    let laws = [
+        "spring_dashpot",
+        "continuous",
+        "overlap_area",
+        "hertz_cohesive",
+        "mod",
+    ];
+    for law in laws {
+        let rust = std::fs::read_to_string(root.join(format!("src/law/{law}.rs"))).unwrap();
+        let twin = (rust.lines())
+            .find_map(|l| l.split("WGSL twin: `").nth(1))
+            .and_then(|rest| rest.split('`').next())
+            .unwrap_or_else(|| panic!("src/law/{law}.rs: `evaluate` names no WGSL twin"));
+        let signature = format!("fn {twin}(c: ContactInput) -> ContactOutput {{");
+        assert!(
+            wgsl.contains(&signature),
+            "src/law/{law}.rs names `{twin}`, which shaders/laws.wgsl lacks"
+        );
+        assert!(rust.contains("pub fn evaluate(&self, c: &ContactInput) -> ContactOutput"));
+    }
+}

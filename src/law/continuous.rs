@@ -110,6 +110,7 @@ impl Continuous {
         self.r0
     }
 
+    /// WGSL twin: `continuous` in shaders/laws.wgsl (its coefficients from `Params`).
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         let m = c.mass;
         let f_e = self.elastic_force(m, c.sigma, c.r);

@@ -98,6 +98,7 @@ impl HertzCohesive {
     }
 
     /// Forces on particle 1 along n and t for a sub-contact of overlap δ (negative: a gap).
+    /// WGSL twin: `hertz_cohesive` in shaders/laws.wgsl (its coefficients from `Params`).
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         let delta = c.delta;
         if delta.is_nan() || delta <= -self.d_c {

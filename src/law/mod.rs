@@ -187,6 +187,7 @@ impl ContactLaw {
         input_r < self.range_factor() * sigma
     }
 
+    /// The scene's law on one contact. WGSL twin: `evaluate` in shaders/laws.wgsl.
     #[inline(always)]
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         match self {

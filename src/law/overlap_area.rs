@@ -200,6 +200,7 @@ impl OverlapArea {
 
     /// c.delta = A/l, c.delta_dot = d(A/l)/dt, c.r = the penetration depth A/L (for the
     /// energy; 0 when the chord vanishes).
+    /// WGSL twin: `overlap_area` in shaders/laws.wgsl (its coefficients from `Params`).
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         let (k_n, eta_n, k_t, eta_t, mu, m) = match &self.pairs {
             None => (self.k_n, self.eta_n, self.k_t, self.eta_t, self.mu, c.m12),

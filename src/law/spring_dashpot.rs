@@ -234,6 +234,7 @@ impl SpringDashpot {
         }
     }
 
+    /// WGSL twin: `spring_dashpot` in shaders/laws.wgsl (its coefficients from `Params`).
     #[inline(always)]
     pub fn evaluate(&self, c: &ContactInput) -> ContactOutput {
         let (k_n, gamma_n, k_t, gamma_t, mu) = self.coefficients(c);
