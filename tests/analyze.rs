@@ -519,7 +519,7 @@ fn grains_that_rolled_away_do_not_widen_the_heap() {
 #[test]
 fn a_run_with_output_vtk_writes_a_paraview_time_series() {
     let dir = tmp("vtk-run");
-    let o = common::command([
+    common::talus_ok([
         "run",
         "-q",
         "--backend",
@@ -534,10 +534,7 @@ fn a_run_with_output_vtk_writes_a_paraview_time_series() {
         "stop.time=3",
         "--set",
         "stop.kinetic_fraction=null",
-    ])
-    .output()
-    .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    ]);
     let pvd = std::fs::read_to_string(dir.join("snapshots/snapshots.pvd")).unwrap();
     // Snapshots at t = 1, 2, 3 have grains (t = 0 is before the first one falls in).
     let files: Vec<&str> = pvd
@@ -1170,12 +1167,8 @@ fn vtk_draws_disks_as_points_and_polygons_as_their_outlines() {
 
 /// `talus render` of a snapshot into `out`, small pictures.
 fn render(snapshot: &Path, out: &Path) {
-    let o = common::command(["render", "--width", "64", "--out"])
-        .arg(out)
-        .arg(snapshot)
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let (out, snapshot) = (out.to_str().unwrap(), snapshot.to_str().unwrap());
+    common::talus_ok(["render", "--width", "64", "--out", out, snapshot]);
 }
 
 /// A LAMMPS-style dump (`dump custom`'s layout, `render::dump`), parsed as OVITO and
@@ -1280,23 +1273,22 @@ fn render_writes_a_lammps_style_dump_that_holds_the_snapshot_exactly() {
 #[test]
 fn a_run_with_output_dump_writes_one_dump_per_snapshot() {
     let dir = tmp("dump-run");
-    let o = common::command(["run", "-q", "--backend", "cpu", "--out"])
-        .arg(&dir)
-        .args([
-            "--set",
-            "output.dump=true",
-            "--set",
-            "output.snapshot_every=1",
-        ])
-        .args([
-            "--set",
-            "stop.time=3",
-            "--set",
-            "stop.kinetic_fraction=null",
-        ])
-        .output()
-        .unwrap();
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    common::talus_ok([
+        "run",
+        "-q",
+        "--backend",
+        "cpu",
+        "--out",
+        dir.to_str().unwrap(),
+        "--set",
+        "output.dump=true",
+        "--set",
+        "output.snapshot_every=1",
+        "--set",
+        "stop.time=3",
+        "--set",
+        "stop.kinetic_fraction=null",
+    ]);
     let mut dumps: Vec<PathBuf> = (std::fs::read_dir(dir.join("snapshots")).unwrap())
         .map(|e| e.unwrap().path())
         .filter(|p| p.extension().is_some_and(|e| e == "dump"))
