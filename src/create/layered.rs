@@ -13,7 +13,9 @@
 //! give H = k h. Grains that settle into the row below, as irregular polygons do, then
 //! get wider rows, and the pile grows to the outline asked for. With `row_height` the
 //! rows have a fixed height instead: row k is w_0 − 2 k h / tan α wide and holds
-//! ⌊w_k / d_max⌋ evenly spaced particles, whatever the pile does.
+//! ⌊w_k / d_max⌋ evenly spaced particles, whatever the pile does. With `rows` the block
+//! stops after that many rows: under an outline steeper than the grains stand, the
+//! flanks then take the grains' own slope, not the outline's.
 //!
 //! Each particle is placed `gap` · d_max above the highest particle within d_max of it
 //! horizontally (or the floor), so it never starts inside another. Particles are drawn

@@ -23,7 +23,9 @@ pub fn repose_deg(id: &str, variant: &str) -> Option<PaperNumber> {
         ("R7", "wedge-mono") => Some(number(23.0, None, "paper 000 (Table 2)")),
         ("R7", "wedge-medium") => Some(number(24.0, None, "paper 000 (Table 2)")),
         ("R7", "wedge-poly") => Some(number(28.0, None, "paper 000 (Table 2)")),
-        ("R7", "layered-medium") => Some(number(32.0, None, "paper 000 (Table 2)")),
+        ("R7", "layered-medium" | "layered-free") => {
+            Some(number(32.0, None, "paper 000 (Table 2)"))
+        }
         _ => None,
     }
 }

@@ -43,6 +43,19 @@ pub fn variants(id: &str, size: Size) -> Result<Vec<Variant>, ReproductionError>
     }
     let full = size != Size::Reduced;
     let r7 = |name: &str, scene: &'static str| v(name, scene, &[], 14.0, 2.0);
+    // The layered heap without an outline that sets its slope (issue 40): rows laid
+    // under a 60° outline, far steeper than the grains stand, and stopped after `rows`
+    // rows (about the paper's 3400 grains at full width), so that the flanks take the
+    // slope the gently dropped grains hold.
+    let r7_layered_free = |rows: u32| {
+        let mut x = r7("layered-free", R7_LAYERED);
+        x.overrides = vec![
+            "particles[0].slope=60".into(),
+            format!("particles[0].rows={rows}"),
+            "stop.time=100".into(),
+        ];
+        x
+    };
     let lattice = |name: &str, set: Vec<String>| {
         let mut x = v(
             name,
@@ -238,11 +251,14 @@ pub fn variants(id: &str, size: Size) -> Result<Vec<Variant>, ReproductionError>
                 "particles[0].base_width=0.38".into(),
                 "stop.time=100".into(),
             ];
+            let mut free = r7_layered_free(22);
+            free.overrides.push("particles[0].base_width=0.38".into());
             vec![
                 wedge("wedge-mono", R7_MONO, 800),
                 wedge("wedge-medium", R7_MEDIUM, 1200),
                 wedge("wedge-poly", R7_POLY, 600),
                 layered,
+                free,
             ]
         }
         "R7" => vec![
@@ -250,6 +266,7 @@ pub fn variants(id: &str, size: Size) -> Result<Vec<Variant>, ReproductionError>
             r7("wedge-medium", R7_MEDIUM),
             r7("wedge-poly", R7_POLY),
             r7("layered-medium", R7_LAYERED),
+            r7_layered_free(27),
         ],
         // The pile created whole on its lattice and settled (`mu-…`), and built as paper
         // 000 sec. 5.2 builds it, layer by layer onto the fixed bottom row

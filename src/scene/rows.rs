@@ -30,11 +30,13 @@ fn fixed_row_count(spec: &Layered) -> u32 {
 
 /// The most rows the block lays: all of them with fixed rows; with measured rows, as
 /// many as a pile rising by a quarter of a close-packed row per row would need (a pile
-/// that rises less, because its grains flow away, is left unfinished there).
+/// that rises less, because its grains flow away, is left unfinished there); never more
+/// than `rows`.
 pub fn max_rows(spec: &Layered) -> u32 {
-    if spec.row_height.is_some() {
+    let outline = if spec.row_height.is_some() {
         fixed_row_count(spec)
     } else {
         4 * fixed_row_count(spec)
-    }
+    };
+    spec.rows.map_or(outline, |r| r.min(outline))
 }

@@ -289,6 +289,11 @@ pub struct Layered {
     /// follow the pile's measured height (the default).
     #[serde(default)]
     pub row_height: Option<f64>,
+    /// The most rows to lay (default: as many as the outline takes). With an outline
+    /// steeper than the grains can stand, the rows stop here and the flanks take the
+    /// slope the grains hold, not the outline's.
+    #[serde(default)]
+    pub rows: Option<u32>,
 }
 
 fn default_gap() -> f64 {

@@ -331,6 +331,12 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
                 if let Some(h) = s.row_height {
                     finite_positive(&at("row_height"), h)?;
                 }
+                if s.rows == Some(0) {
+                    return Err(SceneError::invalid(
+                        at("rows"),
+                        "must be at least 1 (leave it out to lay rows up to the outline)",
+                    ));
+                }
                 if !(s.slope > 0.0 && s.slope < 90.0) {
                     return Err(SceneError::invalid(
                         at("slope"),
@@ -349,8 +355,9 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
                 // close-packed rows of the largest particle (measured rows of smaller or
                 // settling grains take more).
                 let h = s.row_height.unwrap_or(0.5 * 3f64.sqrt()) * d;
-                let rows =
+                let outline =
                     ((s.base_width - d) * s.slope.to_radians().tan() / (2.0 * h)).floor() + 1.0;
+                let rows = s.rows.map_or(outline, |r| outline.min(r as f64));
                 let built = s.start_time + (rows - 1.0) * s.interval;
                 if scene.stop.time < built {
                     // In exponent form when huge (a `row_height` of 1e-300 asks for 10³⁰⁰ rows).
@@ -360,7 +367,7 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
                         (format!("{rows:.3e}"), format!("{built:.3e}"))
                     };
                     warnings.push(format!(
-                        "particles[{k}]: stop.time = {} ends the run before the layered pile is built: its outline needs at least {rows} rows, one every {} (the last at t = {built})",
+                        "particles[{k}]: stop.time = {} ends the run before the layered pile is built: it lays at least {rows} rows, one every {} (the last at t = {built})",
                         scene.stop.time, s.interval
                     ));
                 }
