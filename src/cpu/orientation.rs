@@ -12,11 +12,10 @@ use crate::state::Particles;
 pub struct RotatedCorners {
     pub start: Vec<u32>,
     pub corners: Vec<P2>,
-    /// Which particle each corner belongs to, every body corner in one array, and each
-    /// particle's (sin θ, cos θ): laid out again only when particles were added.
+    /// Which particle each corner belongs to and every body corner in one array: laid
+    /// out again only when particles were added.
     owner: Vec<u32>,
     body: Vec<P2>,
-    turn: Vec<[f64; 2]>,
 }
 
 impl RotatedCorners {
@@ -55,21 +54,18 @@ pub fn rotate_corners(particles: &Particles, out: &mut RotatedCorners) {
     if out.body.is_empty() {
         return; // disks only
     }
-    out.turn.resize(particles.len(), [0.0; 2]);
-    let q = &particles.q[0];
-    let shapes = &particles.shape;
-    crate::base::parallel::for_each(&mut out.turn, |i, sc| {
-        if !shapes[i].is_empty() {
-            let (s, c) = q[i][2].sin_cos();
-            *sc = [s, c];
-        }
-    });
-    let (owner, body, turn) = (&out.owner, &out.body, &out.turn);
+    let (owner, body, q) = (&out.owner, &out.body, &particles.q[0]);
+    // One pass over the corners: each polygon's (sin θ, cos θ) is taken at its first
+    // corner in the thread's share and used for the rest of its corners.
     crate::base::parallel::for_each_share(&mut out.corners, |k0, share| {
         let n = share.len();
         let from = body[k0..k0 + n].iter().zip(&owner[k0..k0 + n]);
+        let (mut last, mut s, mut c) = (u32::MAX, 0.0, 1.0);
         for (x, (v, &o)) in share.iter_mut().zip(from) {
-            let [s, c] = turn[o as usize];
+            if o != last {
+                (s, c) = q[o as usize][2].sin_cos();
+                last = o;
+            }
             *x = [c * v[0] - s * v[1], s * v[0] + c * v[1]];
         }
     });
