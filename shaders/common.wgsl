@@ -191,6 +191,7 @@ struct Wall {
     nq: vec2<i32>,      // the line's unit normal (-t.y, t.x) in Q30 (host: gpu/mod.rs)
     beta: f32,          // nq/2^30 = (1 + alpha) n + beta t: its turn off the true normal
     alpha: f32,         // and its stretch
+    velocity: vec2<f32>, // the surface's velocity, along the wall (scene walls[k].velocity)
 };
 
 struct Entry {

@@ -101,6 +101,9 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
         let m2 = props[j].mass;
         m12 = m1 * m2 / (m1 + m2);
         mass = 2.0 * m12;
+    } else if (WALLS) {
+        // A wall's surface moves along it (scene walls[k].velocity).
+        v2 = vec3<f32>(walls[j - WALL_BASE].velocity, 0.0);
     }
     // The law sees the rate of delta: the overlap's for disks, L v_n / l for the
     // overlap area (delta = A/l; src/cpu/forces/kinematics.rs `area_kinematics`).
@@ -154,7 +157,7 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
         pair = pair_slot(i, j, wall);
     }
     // The centres' velocity and the spins, for the continuous law's readings (v2 of a
-    // wall is zero).
+    // wall is its surface's velocity, with no spin).
     let v_centres = dot(v1.xy - v2.xy, t);
     let input = ContactInput(g.delta, g.r, g.sigma, -dot(v12, g.n) * rate, dot(v12, t),
                              m12, mass, hist_in[slot], params.dt, m_eff, pair,

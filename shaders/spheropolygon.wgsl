@@ -329,6 +329,7 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
         } else {
             subs.count = 0u;
         }
+        v2 = vec3<f32>(walls[j - WALL_BASE].velocity, 0.0);
     } else if (!circles_near(i, j)) {
         subs.count = 0u;
     } else {
@@ -372,7 +373,7 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
         let l2 = l1 + d_ij;
         let s1 = v1.z * vec2<f32>(-l1.y, l1.x);
         var s2 = vec2<f32>(0.0);
-        if (!wall) { s2 = v2.xy + v2.z * vec2<f32>(-l2.y, l2.x); }
+        if (wall) { s2 = v2.xy; } else { s2 = v2.xy + v2.z * vec2<f32>(-l2.y, l2.x); }
         let v12 = v1.xy + s1 - s2;
         let t = tangent(n);
         var history = 0.0;

@@ -272,6 +272,7 @@ fn cpu_contact_forces(
         &host.particles,
         &shapes,
         &host.walls,
+        &host.wall_velocity,
         &host.law,
         host.dt(),
         pairs,

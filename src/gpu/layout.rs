@@ -231,6 +231,8 @@ pub struct Wall {
     /// β = q·t, α = q·n − 1 (both up to ~2⁻³¹).
     pub beta: f32,
     pub alpha: f32,
+    /// The surface's velocity, along the wall (scene `walls[k].velocity`).
+    pub velocity: [f32; 2],
 }
 
 #[repr(C)]
@@ -380,7 +382,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
             Wall,
             "Wall",
             [
-                a_anchor, a_frac, a_rem, b_anchor, b_frac, b_rem, ab, nq, beta, alpha
+                a_anchor, a_frac, a_rem, b_anchor, b_frac, b_rem, ab, nq, beta, alpha, velocity
             ]
         ),
         fields!(Entry, "Entry", [i, j, value, _pad]),

@@ -303,12 +303,14 @@ pub fn table_lookup(table: &[Entry], i: u32, j: u32) -> Option<f32> {
 /// The walls in the device's layout: both ends in fixed point, the exact normal.
 pub(super) fn device_walls(
     walls: &[crate::base::geometry::WallSegment],
+    velocity: &[[f64; 2]],
     origin: [f64; 2],
     cell_size: f32,
 ) -> Vec<Wall> {
     walls
         .iter()
-        .map(|w| {
+        .zip(velocity)
+        .map(|(w, v)| {
             let (a_anchor, a_frac, a_rem) =
                 position::split2(w.a[0] - origin[0], w.a[1] - origin[1], cell_size);
             let (b_anchor, b_frac, b_rem) =
@@ -325,6 +327,7 @@ pub(super) fn device_walls(
                 nq,
                 beta,
                 alpha,
+                velocity: [v[0] as f32, v[1] as f32],
             }
         })
         .collect()

@@ -168,6 +168,15 @@ pub struct PolygonSpec {
 pub struct Wall {
     pub from: [f64; 2],
     pub to: [f64; 2],
+    /// The velocity of the wall's surface, along the wall (a belt, or a wall shearing
+    /// the material; LAMMPS `fix wall/gran ... shear`): it enters the relative velocity
+    /// of the wall's contacts; the segment itself stays where it is.
+    #[serde(default, skip_serializing_if = "at_rest")]
+    pub velocity: [f64; 2],
+}
+
+fn at_rest(v: &[f64; 2]) -> bool {
+    *v == [0.0; 2]
 }
 
 /// A size: a fixed diameter or a uniform distribution of diameters.

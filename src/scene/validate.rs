@@ -253,6 +253,26 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
         // was inert).
         inside(scene, &format!("walls[{k}].from"), w.from)?;
         inside(scene, &format!("walls[{k}].to"), w.to)?;
+        let v = w.velocity;
+        if !v.iter().all(|v| v.is_finite()) {
+            return Err(SceneError::invalid(
+                format!("walls[{k}].velocity"),
+                format!("must be finite, got {v:?}"),
+            ));
+        }
+        // Only along the wall: a wall moving across its line would move its contacts and
+        // its neighbour lists, which talus does not do yet.
+        let t = [w.to[0] - w.from[0], w.to[1] - w.from[1]];
+        let across = (t[0] * v[1] - t[1] * v[0]).abs();
+        if across > 1e-9 * t[0].hypot(t[1]) * v[0].hypot(v[1]) {
+            return Err(SceneError::invalid(
+                format!("walls[{k}].velocity"),
+                format!(
+                    "{v:?} is not along the wall (from {:?} to {:?}): only a surface moving along its wall (a belt, a shearing wall) is supported, not a wall moving across its line",
+                    w.from, w.to
+                ),
+            ));
+        }
     }
     if scene.particles.is_empty() {
         return Err(SceneError::invalid(

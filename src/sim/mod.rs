@@ -40,6 +40,8 @@ pub struct Simulation {
     pub scene: Scene,
     pub law: ContactLaw,
     pub walls: Vec<WallSegment>,
+    /// Each wall's surface velocity (scene `walls[k].velocity`, along the wall).
+    pub wall_velocity: Vec<[f64; 2]>,
     pub grid: Grid,
     pub particles: Particles,
     /// The tangential springs the state was created with (a checkpoint's, or the GPU
@@ -160,12 +162,14 @@ impl Simulation {
             .iter()
             .map(|w| WallSegment { a: w.from, b: w.to })
             .collect();
+        let wall_velocity = scene.walls.iter().map(|w| w.velocity).collect();
         let max_d = crate::scene::max_diameter(&scene).max(2.0 * particles.max_radius());
         let grid = Grid::new(scene.domain.x, scene.domain.z, law.range_factor() * max_d);
         Ok(Self {
             scene,
             law,
             walls,
+            wall_velocity,
             grid,
             particles,
             springs,
@@ -370,6 +374,7 @@ impl Simulation {
             velocity: &self.velocity,
             corners: &self.corners,
             walls: &self.walls,
+            wall_velocity: &self.wall_velocity,
             dt: self.scene.dt,
             pair_side: self.law.pair_table().map_or(0, |t| t.side),
         };

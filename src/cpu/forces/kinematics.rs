@@ -72,7 +72,7 @@ pub(super) fn disk_kinematics(
             let v = s.velocity[pair.j as usize];
             ([v[0], v[1]], v[2])
         }
-        _ => ([0.0, 0.0], 0.0),
+        _ => (wall_velocity(s, pair), 0.0),
     };
     let v_centres = (v1[0] - vc2[0]) * t[0] + (v1[1] - vc2[1]) * t[1];
     let m1 = s.particles.mass[i];
@@ -124,8 +124,15 @@ pub(super) fn material_pair(s: &StepState, pair: Pair, m12: f64) -> (f64, u32) {
     )
 }
 
-/// Velocity of particle j's material at the contact point (zero for a wall), and its
-/// mass. The point is `arm` from r_i, so `arm + d` from r_j (d = r_i − r_j).
+/// The surface velocity of a wall pair's wall.
+#[inline(always)]
+pub(super) fn wall_velocity(s: &StepState, pair: Pair) -> [f64; 2] {
+    s.wall_velocity[(pair.j - WALL_BASE) as usize]
+}
+
+/// Velocity of particle j's material at the contact point (a wall's surface velocity),
+/// and its mass (infinite for a wall). The point is `arm` from r_i, so `arm + d` from
+/// r_j (d = r_i − r_j).
 #[inline(always)]
 pub(super) fn material_velocity(
     s: &StepState,
@@ -134,7 +141,7 @@ pub(super) fn material_velocity(
     d: Option<[f64; 2]>,
 ) -> ([f64; 2], f64) {
     let (false, Some(d)) = (pair.is_wall(), d) else {
-        return ([0.0, 0.0], f64::INFINITY);
+        return (wall_velocity(s, pair), f64::INFINITY);
     };
     let j = pair.j as usize;
     let v = s.velocity[j];

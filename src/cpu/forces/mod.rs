@@ -57,6 +57,8 @@ pub struct StepState<'a> {
     pub velocity: &'a [Dof],
     pub corners: &'a RotatedCorners,
     pub walls: &'a [WallSegment],
+    /// Each wall's surface velocity.
+    pub wall_velocity: &'a [[f64; 2]],
     pub dt: f64,
     /// The side of the material form's pair table (src/law/restitution.rs); 0 without.
     pub pair_side: usize,
@@ -74,6 +76,7 @@ pub fn contact_forces(
     particles: &Particles,
     corners: &RotatedCorners,
     walls: &[WallSegment],
+    wall_velocity: &[[f64; 2]],
     law: &ContactLaw,
     dt: f64,
     pairs: &[Pair],
@@ -88,6 +91,7 @@ pub fn contact_forces(
         velocity: &velocity,
         corners,
         walls,
+        wall_velocity,
         dt,
         pair_side: law.pair_table().map_or(0, |t| t.side),
     };

@@ -102,7 +102,8 @@ pub(super) fn spheropolygon_candidate(
     let f = if pair.is_wall() {
         let w = wall_from(&s.walls[(pair.j - WALL_BASE) as usize], p.position(i));
         let seg = [w.a, w.b];
-        let motion = (s.velocity[i], [0.0; 3]);
+        let v = super::kinematics::wall_velocity(s, pair);
+        let motion = (s.velocity[i], [v[0], v[1], 0.0]);
         crate::cpu::forces::rods::pair_force(
             law,
             core(i),
