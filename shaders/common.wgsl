@@ -147,7 +147,8 @@ struct Params {
     // READING_SLIP_DAMPING | READING_CONTACT_ARM, 0 for the paper's text; its clamp
     // is `clamp`.
     reading: u32,
-    pad_pair1: u32,
+    // rolling resistance at disk contacts (src/law/rolling.rs): mu_r, 0 for none
+    rolling_mu: f32,
     pad_pair2: u32,
     pair_law: array<vec4<f32>, 2u * MAX_PAIR_SLOTS>,
 };

@@ -82,6 +82,20 @@ fn contact_forces(@builtin(global_invocation_id) gid: vec3<u32>,
     }
 }
 
+// src/law/rolling.rs AT_REST (checked by tests/gpu_constants.rs).
+const ROLLING_AT_REST: f32 = 0.1;
+
+// Twin of src/law/rolling.rs `rolling_torque`: the constant directional torque of Ai et
+// al. (2011) eq. 6 against the relative spin, limited near rest to ROLLING_AT_REST of
+// what stops it in one step.
+fn rolling_torque(mu_r: f32, spin: f32, r_roll: f32, f_n: f32, inv_inertia_sum: f32,
+                  dt: f32) -> f32 {
+    if (!(inv_inertia_sum > 0.0) || spin == 0.0) { return 0.0; }
+    let full = mu_r * r_roll * max(f_n, 0.0);
+    let near_rest = ROLLING_AT_REST * abs(spin) / (inv_inertia_sum * dt);
+    return -sign(spin) * min(full, near_rest);
+}
+
 // Candidate `slot` of particle i's list; i's radius, mass and velocity.
 fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
     let j = contact_j[slot];
@@ -167,6 +181,20 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
     // Paper 001 eq. 13 (src/cpu/forces/mod.rs `contact_force`): both torques on the law's lever.
     var torques = vec2<f32>(cross2(l1, f), -cross2(l2, f));
     if (res.lever > 0.0) { torques = vec2<f32>(-res.lever * res.f_t); }
+    if (!POLYGONS && params.rolling_mu > 0.0) {
+        // src/cpu/forces/mod.rs `rolling`: on i, and its opposite on j.
+        var spin = v1.z;
+        var r_roll = ri;
+        var inv_inertia = select(props[i].inv_inertia, 0.0, is_fixed(i));
+        if (!wall) {
+            spin = v1.z - v2.z;
+            let rj = props[j].radius;
+            r_roll = ri * rj / (ri + rj);
+            inv_inertia += select(props[j].inv_inertia, 0.0, is_fixed(j));
+        }
+        let m = rolling_torque(params.rolling_mu, spin, r_roll, res.f_n, inv_inertia, params.dt);
+        torques += vec2<f32>(m, -m);
+    }
     contact_ft[slot] = vec4<f32>(f, torques);
     // In place: the slot's spring is the list's history from step to step.
     hist_in[slot] = res.history;

@@ -274,6 +274,7 @@ fn cpu_contact_forces(
         &host.walls,
         &host.wall_velocity,
         &host.law,
+        host.rolling,
         host.dt(),
         pairs,
         history,

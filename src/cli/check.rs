@@ -40,6 +40,12 @@ pub(super) fn cmd_check(
     for line in lines {
         out!("{line}");
     }
+    if !sim.rolling.is_none() {
+        out!(
+            "rolling resistance at disk contacts: constant torque μ_r R* f_n against the relative spin, μ_r = {} (R* = R_i R_j/(R_i + R_j), R_i at a wall; src/law/rolling.rs)",
+            sim.rolling.mu_r
+        );
+    }
     if backend == Some(Backend::Gpu) {
         check_gpu_fit(&sim)?;
     }

@@ -138,6 +138,8 @@ pub fn shared() -> Vec<(&'static str, Value)> {
         u("MAX_SUB", MAX_SUB),
         // laws.wgsl
         u("LAW_ANY", layout::LAW_ANY),
+        // contact_forces.wgsl
+        f("ROLLING_AT_REST", crate::law::rolling::AT_REST),
         // prefix_sum.wgsl
         u("SCAN_WG", layout::SCAN_WG),
         // predict.wgsl: the predictor's binomials C(l, k) as GEAR_P<k><l> (src/integrate/

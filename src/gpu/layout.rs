@@ -147,7 +147,8 @@ pub struct Params {
     /// The continuous law's readings of paper 001 (src/law/continuous.rs `Reading`):
     /// `READING_SLIP_DAMPING` | `READING_CONTACT_ARM`, 0 for the paper's text.
     pub reading: u32,
-    pub pad_pair1: u32,
+    /// Rolling resistance at disk contacts (src/law/rolling.rs): μ_r, 0 for none.
+    pub rolling_mu: f32,
     pub pad_pair2: u32,
     /// Slot s = a · pair_side + b of materials a and b (b = pair_side − 1: a wall):
     /// `pair_law[2s]` = (k_n, γ_n, k_t, γ_t), `pair_law[2s + 1].x` = μ.
@@ -355,7 +356,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 pair_side,
                 per_mass,
                 reading,
-                pad_pair1,
+                rolling_mu,
                 pad_pair2,
                 pair_law
             ]

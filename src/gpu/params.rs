@@ -210,6 +210,7 @@ pub(super) fn step_params(
         reorder: 1,
         list_cap: super::list_capacity(sim),
         max_step2: sim.scene.limits.max_step_displacement.powi(2) as f32,
+        rolling_mu: sim.rolling.mu_r as f32,
         ..Default::default()
     };
     law_params(law, &mut params);

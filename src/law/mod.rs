@@ -10,6 +10,7 @@ pub mod continuous;
 pub mod hertz_cohesive;
 pub mod overlap_area;
 pub mod restitution;
+pub mod rolling;
 pub mod spec;
 pub mod spring_dashpot;
 pub mod tangential;

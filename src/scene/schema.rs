@@ -27,6 +27,9 @@ pub struct Scene {
     pub contact: ContactSpec,
     #[serde(default)]
     pub walls: Vec<Wall>,
+    /// Rolling resistance at disk contacts (src/law/rolling.rs); none unless given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rolling: Option<crate::law::rolling::RollingSpec>,
     pub particles: Vec<Creation>,
     #[serde(default)]
     pub output: Output,

@@ -425,8 +425,29 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
 
     let law = ContactLaw::of_scene(scene)?;
     spheropolygons(scene, &law)?;
+    rolling(scene)?;
     warnings.extend(super::stability::time_step(scene, &law)?);
     Ok(Checked { law, warnings })
+}
+
+/// Rolling resistance (src/law/rolling.rs) acts at disk contacts: under the disk laws,
+/// which take disks only (polygons need the overlap-area law, rods `hertz_cohesive`).
+fn rolling(scene: &Scene) -> Result<(), SceneError> {
+    let Some(r) = &scene.rolling else {
+        return Ok(());
+    };
+    finite_non_negative("rolling.mu_r", r.mu_r)?;
+    let law = match scene.contact {
+        ContactSpec::OverlapArea(_) => "overlap_area",
+        ContactSpec::HertzCohesive(_) => "hertz_cohesive",
+        _ => return Ok(()),
+    };
+    Err(SceneError::invalid(
+        "rolling",
+        format!(
+            "rolling resistance acts at disk contacts under the laws spring_dashpot, continuous and hooke_equivalent, not under \"{law}\" (polygons and rods resist rolling by their shape)"
+        ),
+    ))
 }
 
 /// Rods (spheropolygons) and law `hertz_cohesive` go together (issue 15): rods need the

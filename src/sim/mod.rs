@@ -13,6 +13,7 @@ use crate::cpu::springs::SpringTable;
 use crate::create::{self, source::SourceState};
 use crate::integrate::{gear, leapfrog};
 use crate::law::ContactLaw;
+use crate::law::rolling::Rolling;
 use crate::scene::{IntegratorKind, Scene, SceneError};
 use crate::state::{Dof, Particles};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -42,6 +43,8 @@ pub struct Simulation {
     pub walls: Vec<WallSegment>,
     /// Each wall's surface velocity (scene `walls[k].velocity`, along the wall).
     pub wall_velocity: Vec<[f64; 2]>,
+    /// Rolling resistance at disk contacts (scene `rolling`).
+    pub rolling: Rolling,
     pub grid: Grid,
     pub particles: Particles,
     /// The tangential springs the state was created with (a checkpoint's, or the GPU
@@ -166,6 +169,7 @@ impl Simulation {
         let max_d = crate::scene::max_diameter(&scene).max(2.0 * particles.max_radius());
         let grid = Grid::new(scene.domain.x, scene.domain.z, law.range_factor() * max_d);
         Ok(Self {
+            rolling: Rolling::of(scene.rolling.as_ref()),
             scene,
             law,
             walls,
@@ -377,6 +381,7 @@ impl Simulation {
             wall_velocity: &self.wall_velocity,
             dt: self.scene.dt,
             pair_side: self.law.pair_table().map_or(0, |t| t.side),
+            rolling: self.rolling,
         };
         candidate_forces(
             &state,

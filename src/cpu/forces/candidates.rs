@@ -55,7 +55,7 @@ pub fn candidate_force_hinted<L: Law>(
         let (g, input) = disk_kinematics(s, pair, history, g, d);
         (g, input, Hint::NONE)
     };
-    let r = contact_force(s.particles, |c| law.evaluate(c), pair, &g, &input);
+    let r = contact_force(s, |c| law.evaluate(c), pair, &g, &input);
     (Some(r), hint)
 }
 
@@ -85,7 +85,7 @@ pub(super) fn disk_candidate_force<L: Law>(
     (g, d): (Geometry, Option<[f64; 2]>),
 ) -> (ContactForce, f64) {
     let (g, input) = disk_kinematics(s, pair, history, g, d);
-    contact_force(s.particles, |c| law.evaluate(c), pair, &g, &input)
+    contact_force(s, |c| law.evaluate(c), pair, &g, &input)
 }
 
 /// Candidates of a disk law evaluated per block, each half for the whole block at once.
@@ -253,7 +253,7 @@ pub(super) fn candidates_with<L: Law>(
                 let k = k0 + m;
                 let r = geometry[m].map(|c| {
                     let (g, input) = area_kinematics(s, pairs[m], list.history[k], c);
-                    contact_force(s.particles, |c| law.evaluate(c), pairs[m], &g, &input)
+                    contact_force(s, |c| law.evaluate(c), pairs[m], &g, &input)
                 });
                 settle(k, r, kick, h);
             }

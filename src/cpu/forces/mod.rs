@@ -10,6 +10,7 @@
 use crate::base::geometry::{Geometry, WallSegment, tangent};
 use crate::cpu::contacts::Pair;
 use crate::cpu::orientation::RotatedCorners;
+use crate::law::rolling::{Rolling, rolling_radius, rolling_torque};
 use crate::law::{ContactInput, ContactLaw, ContactOutput};
 use crate::state::{Dof, Particles, offset};
 
@@ -62,6 +63,8 @@ pub struct StepState<'a> {
     pub dt: f64,
     /// The side of the material form's pair table (src/law/restitution.rs); 0 without.
     pub pair_side: usize,
+    /// Rolling resistance at disk contacts (scene `rolling`).
+    pub rolling: Rolling,
 }
 
 /// Stage: the velocity (vx, vz, ω) = q1/dt of every particle.
@@ -78,6 +81,7 @@ pub fn contact_forces(
     walls: &[WallSegment],
     wall_velocity: &[[f64; 2]],
     law: &ContactLaw,
+    rolling: Rolling,
     dt: f64,
     pairs: &[Pair],
     history_in: &[f64],
@@ -94,13 +98,14 @@ pub fn contact_forces(
         wall_velocity,
         dt,
         pair_side: law.pair_table().map_or(0, |t| t.side),
+        rolling,
     };
     out.clear();
     history_out.clear();
     let area = matches!(law, ContactLaw::OverlapArea(_));
     for (&pair, &history) in pairs.iter().zip(history_in) {
         let (g, input) = contact_input(&s, area, pair, history);
-        let (c, h) = contact_force(particles, |c| law.evaluate(c), pair, &g, &input);
+        let (c, h) = contact_force(&s, |c| law.evaluate(c), pair, &g, &input);
         out.push(c);
         history_out.push(h);
     }
@@ -110,12 +115,13 @@ pub fn contact_forces(
 /// updated history.
 #[inline(always)]
 pub(super) fn contact_force(
-    particles: &Particles,
+    s: &StepState,
     evaluate: impl Fn(&ContactInput) -> ContactOutput,
     pair: Pair,
     g: &Geometry,
     input: &ContactInput,
 ) -> (ContactForce, f64) {
+    let particles = s.particles;
     let res = evaluate(input);
     let t = tangent(g.n);
     let force = [
@@ -128,9 +134,15 @@ pub(super) fn contact_force(
         let d = offset(particles, i, pair.j as usize);
         [g.arm[0] + d[0], g.arm[1] + d[1]]
     });
+    let mut torque = res.torques(force, g.arm, arm_j);
+    if !s.rolling.is_none() {
+        // On i, and its opposite on j (whose torque is −torque[1]).
+        let m = rolling(s, pair, res.f_n);
+        torque = [torque[0] + m, torque[1] + m];
+    }
     let c = ContactForce {
         force,
-        torque: res.torques(force, g.arm, arm_j),
+        torque,
         point: [p[0] + g.arm[0], p[1] + g.arm[1]],
         arm: g.arm,
         n: g.n,
@@ -140,4 +152,32 @@ pub(super) fn contact_force(
         energy: res.energy,
     };
     (c, res.history)
+}
+
+/// The rolling torque on disk i of a disk contact (src/law/rolling.rs), j taking its
+/// opposite; f_n: the contact's normal force.
+#[inline(always)]
+fn rolling(s: &StepState, pair: Pair, f_n: f64) -> f64 {
+    let p = s.particles;
+    let i = pair.i as usize;
+    let inv_inertia = |k: usize| if p.fixed[k] { 0.0 } else { 1.0 / p.inertia[k] };
+    let (spin, r_j, inv_j) = if pair.is_wall() {
+        (s.velocity[i][2], None, 0.0)
+    } else {
+        let j = pair.j as usize;
+        (
+            s.velocity[i][2] - s.velocity[j][2],
+            Some(p.radius[j]),
+            inv_inertia(j),
+        )
+    };
+    let r_roll = rolling_radius(p.radius[i], r_j);
+    rolling_torque(
+        s.rolling.mu_r,
+        spin,
+        r_roll,
+        f_n,
+        inv_inertia(i) + inv_j,
+        s.dt,
+    )
 }
