@@ -235,3 +235,61 @@ fn a_heap_stands_steeper_with_rolling_resistance() {
         "μ_r = 0.4 gives {resisted:.1}° against {free:.1}° without"
     );
 }
+
+/// A disk of unit mass and diameter at rest on a floor inclined by `degrees` (downhill
+/// towards +x), g = 1, μ_r = `MU_R`: its speed along the slope at t = 1 and t = 2; None
+/// on the GPU path without an adapter.
+fn disk_on_an_incline(path: Path, degrees: f64) -> Option<[f64; 2]> {
+    let (s, c) = degrees.to_radians().sin_cos();
+    // Resting on the floor with the overlap of its weight's normal part, m g cos θ / k_n.
+    let h = 0.5 - c / 1.0e4;
+    let disk = json!({ "position": [s * h, c * h], "diameter": 1.0 });
+    let mut v = scene_value(
+        spring_dashpot(),
+        json!([{ "kind": "list", "material": "m", "particles": [disk] }]),
+    );
+    v["walls"] = json!([{ "from": [-50.0 * c, 50.0 * s], "to": [50.0 * c, -50.0 * s] }]);
+    v["gravity"] = json!({ "g": [0.0, -1.0] });
+    v["dt"] = json!(DT);
+    v["rolling"] = json!({ "mu_r": MU_R });
+    let mut e = engine(path, "disk_on_an_incline", sim(&v))?;
+    let mut speed = || {
+        e.advance((1.0 / DT).round() as u64).unwrap();
+        let sim = e.sim().unwrap();
+        let u = sim.particles.velocity(0, sim.dt());
+        u[0] * c - u[1] * s
+    };
+    Some([speed(), speed()])
+}
+
+#[test]
+fn on_an_incline_a_disk_rolls_down_above_the_threshold_and_creeps_below_it() {
+    // Above tan θ = μ_r (10°) the disk rolls down at a = (2/3) g (sin θ − μ_r cos θ)
+    // (the torque's full size, μ_r R m g cos θ). Below it (3°) the constant-torque model
+    // cannot hold it: the torque, limited near rest to AT_REST I ω / dt, balances the
+    // weight's m g R sin θ at ω = m g R sin θ dt / (AT_REST I), so the disk creeps
+    // down at v = ω R (src/law/rolling.rs). Measured on both paths (GPU: lavapipe):
+    // the acceleration and the creep both 2e-4 below these.
+    let at_rest = talus::law::rolling::AT_REST;
+    for path in PATHS {
+        let Some([v1, v2]) = disk_on_an_incline(path, 10.0) else {
+            continue;
+        };
+        let (s, c) = 10f64.to_radians().sin_cos();
+        let a = 2.0 / 3.0 * (s - MU_R * c);
+        eprintln!("{path:?}, 10°: acceleration {} against {a}", v2 - v1);
+        assert!(
+            ((v2 - v1) / a - 1.0).abs() < 1e-3,
+            "{path:?}: {} against {a}",
+            v2 - v1
+        );
+        let [_, creep] = disk_on_an_incline(path, 3.0).unwrap();
+        let (m, r, inertia) = (1.0, 0.5, 0.125);
+        let expected = m * r * 3f64.to_radians().sin() * DT / (at_rest * inertia) * r;
+        eprintln!("{path:?}, 3°: creeps at {creep:e} against {expected:e}");
+        assert!(
+            (creep / expected - 1.0).abs() < 1e-2,
+            "{path:?}: {creep} against {expected}"
+        );
+    }
+}
