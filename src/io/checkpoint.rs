@@ -232,7 +232,7 @@ fn stage_fits(old: &Scene, new: &Scene) -> Result<(), crate::scene::SceneError> 
         return Err(SceneError::invalid(
             "particles",
             "differs from the scene that made the state: a stage goes on with the particles \
-             (and point sources) it has; change gravity, contact, walls, stop or output",
+             (and point sources) it has; change gravity, contact, rolling, walls, stop or output",
         ));
     }
     let names = |s: &Scene| s.materials.keys().cloned().collect::<Vec<_>>().join(", ");
