@@ -293,3 +293,52 @@ fn on_an_incline_a_disk_rolls_down_above_the_threshold_and_creeps_below_it() {
         );
     }
 }
+
+#[test]
+fn a_stage_may_add_rolling_resistance() {
+    // Pour the default heap without it, then go on with μ_r = 0.3 (`--from`): the stage
+    // runs under the new scene (its scene.json has it), and ends elsewhere than the same
+    // stage without it.
+    let dir = tmp("rolling", "stage");
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    let (pour, with, without) = (dir.join("pour"), dir.join("with"), dir.join("without"));
+    let (code, _, err) = talus(["run", "-q", "--set", "stop.time=10", "--out", &s(&pour)]);
+    assert_eq!(code, 0, "{err}");
+    let stage = |out: &std::path::Path, mu_r: &str| {
+        let set = format!("rolling={{\"mu_r\": {mu_r}}}");
+        let (code, _, err) = talus([
+            "run",
+            "-q",
+            "--from",
+            &s(&pour),
+            "--set",
+            "stop.time=14",
+            "--set",
+            &set,
+            "--out",
+            &s(out),
+        ]);
+        assert_eq!(code, 0, "{err}");
+        // The final state's spins (not the provenance, which names the command).
+        let snapshot = talus::io::snapshot::read(&out.join("final.json")).unwrap();
+        snapshot.f64("particles.omega").expect("spins").to_vec()
+    };
+    let (a, b) = (stage(&with, "0.3"), stage(&without, "0"));
+    let scene: Value =
+        serde_json::from_str(&std::fs::read_to_string(with.join("scene.json")).unwrap()).unwrap();
+    assert_eq!(scene["rolling"]["mu_r"], 0.3);
+    assert_ne!(a, b, "the rolling torque changed nothing");
+}
+
+#[test]
+fn talus_check_names_rolling_resistance_and_moving_walls() {
+    let scene = |name: &str| format!("{}/scenes/{name}", env!("CARGO_MANIFEST_DIR"));
+    let out = talus_ok(["check", &scene("rolling_heap.json")]);
+    assert!(
+        out.contains("rolling resistance") && out.contains("μ_r = 0.3"),
+        "{out}"
+    );
+    let out = talus_ok(["check", &scene("belt.json")]);
+    assert!(out.contains("walls[0].velocity"), "{out}");
+    assert!(!out.contains("rolling resistance"), "{out}");
+}

@@ -40,6 +40,15 @@ pub(super) fn cmd_check(
     for line in lines {
         out!("{line}");
     }
+    for (k, v) in sim.wall_velocity.iter().enumerate() {
+        if v[0] != 0.0 || v[1] != 0.0 {
+            out!(
+                "wall {k}: its surface moves along it at ({}, {}) (walls[{k}].velocity); the segment stays in place",
+                v[0],
+                v[1]
+            );
+        }
+    }
     if !sim.rolling.is_none() {
         out!(
             "rolling resistance at disk contacts: constant torque μ_r R* f_n against the relative spin, μ_r = {} (R* = R_i R_j/(R_i + R_j), R_i at a wall; src/law/rolling.rs)",
