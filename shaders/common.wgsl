@@ -10,6 +10,8 @@ const WG: u32 = 64u;
 const MAX_WORKGROUPS: u32 = 65535u;
 const WALL_BASE: u32 = 0xFFFF0000u;
 const EMPTY: u32 = 0xFFFFFFFFu;
+// A disk pair's rolling spring among its SubSprings (src/cpu/springs.rs ROLLING_KEY).
+const ROLLING_KEY: u32 = 0xFFFFFFFEu;
 // Params.law
 const LAW_SPRING_DASHPOT: u32 = 0u;
 const LAW_CONTINUOUS: u32 = 1u;
@@ -147,9 +149,14 @@ struct Params {
     // READING_SLIP_DAMPING | READING_CONTACT_ARM, 0 for the paper's text; its clamp
     // is `clamp`.
     reading: u32,
-    // rolling resistance at disk contacts (src/law/rolling.rs): mu_r, 0 for none
+    // rolling resistance at disk contacts (src/law/rolling.rs): mu_r, 0 for none; the
+    // spring model's k_roll (0: the constant torque) and eta_r
     rolling_mu: f32,
-    pad_pair2: u32,
+    rolling_k: f32,
+    rolling_eta: f32,
+    pad_roll0: u32,
+    pad_roll1: u32,
+    pad_roll2: u32,
     pair_law: array<vec4<f32>, 2u * MAX_PAIR_SLOTS>,
 };
 
@@ -202,10 +209,11 @@ struct Entry {
     _pad: u32,
 };
 
-// A spheropolygon pair's tangential springs, one per sub-contact (src/cpu/springs.rs
-// `SubSprings`; MAX_SUB = 4): the sub-contact's key (`SubContact::key`, EMPTY for none)
-// and its spring. Per candidate slot (`sub_hist`) and per entry of the spring table
-// (`table_sub`, beside `table`).
+// A pair's springs beyond its tangential one (src/cpu/springs.rs `SubSprings`;
+// MAX_SUB = 4): a spheropolygon pair's, one per sub-contact (`SubContact::key`), or a
+// disk pair's rolling spring (key ROLLING_KEY); EMPTY for none. Per candidate slot
+// (`sub_hist`) and per entry of the spring table (`table_sub`, beside `table`), in the
+// scenes that keep them (`sub_springs_kept`).
 struct SubSprings {
     key: vec4<u32>,
     xi: vec4<f32>,
@@ -287,6 +295,12 @@ fn copy_of(flags: u32) -> u32 {
 
 fn is_integrated(i: u32) -> bool {
     return (props[i].flags & (ACTIVE | FIXED)) == ACTIVE;
+}
+
+// Whether the scene keeps SubSprings per candidate and table entry (src/gpu/mod.rs
+// `keeps_sub_springs`): spheropolygons' sub-contact springs, or rolling springs.
+fn sub_springs_kept() -> bool {
+    return params.law == LAW_HERTZ || params.rolling_k > 0.0;
 }
 
 fn halted() -> bool {

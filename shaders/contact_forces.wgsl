@@ -96,6 +96,31 @@ fn rolling_torque(mu_r: f32, spin: f32, r_roll: f32, f_n: f32, inv_inertia_sum: 
     return -sign(spin) * min(full, near_rest);
 }
 
+// Twin of src/law/rolling.rs `rolling_spring`: the spring-dashpot rolling torque of Ai
+// et al. (2011) eq. 9-16 on i (x) and the rolling spring after the step (y).
+fn rolling_spring(spring: f32, spin: f32, r_roll: f32, f_n: f32, inv_rolling_inertia: f32,
+                  dt: f32) -> vec2<f32> {
+    if (!(inv_rolling_inertia > 0.0)) { return vec2<f32>(0.0); }
+    let k_r = params.rolling_k * r_roll * r_roll;
+    let limit = params.rolling_mu * r_roll * max(f_n, 0.0);
+    let m_k = spring - k_r * spin * dt;
+    if (abs(m_k) >= limit) {
+        // Full mobilisation: the spring slips at its limit, no damping.
+        var held = 0.0;
+        if (m_k != 0.0) { held = sign(m_k) * limit; }
+        return vec2<f32>(held, held);
+    }
+    let c_r = params.rolling_eta * 2.0 * sqrt(k_r / inv_rolling_inertia);
+    return vec2<f32>(m_k - c_r * spin, m_k);
+}
+
+// Twin of src/law/rolling.rs `rolling_inertia_inv`: 1/(I + m R^2) of disk k, 0 fixed.
+fn rolling_inertia_inv(k: u32) -> f32 {
+    if (is_fixed(k) || !(props[k].inv_inertia > 0.0)) { return 0.0; }
+    let r = props[k].radius;
+    return 1.0 / (1.0 / props[k].inv_inertia + props[k].mass * r * r);
+}
+
 // Candidate `slot` of particle i's list; i's radius, mass and velocity.
 fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
     let j = contact_j[slot];
@@ -152,6 +177,9 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
     if (!touches) {
         contact_ft[slot] = vec4<f32>(0.0);
         hist_in[slot] = 0.0;
+        if (!POLYGONS && params.rolling_k > 0.0) {
+            sub_hist[slot] = SubSprings(vec4<u32>(EMPTY), vec4<f32>(0.0));
+        }
         touching[slot] = 0u;
         return;
     }
@@ -186,13 +214,27 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
         var spin = v1.z;
         var r_roll = ri;
         var inv_inertia = select(props[i].inv_inertia, 0.0, is_fixed(i));
+        var inv_rolling = rolling_inertia_inv(i);
         if (!wall) {
             spin = v1.z - v2.z;
             let rj = props[j].radius;
             r_roll = ri * rj / (ri + rj);
             inv_inertia += select(props[j].inv_inertia, 0.0, is_fixed(j));
+            inv_rolling += rolling_inertia_inv(j);
         }
-        let m = rolling_torque(params.rolling_mu, spin, r_roll, res.f_n, inv_inertia, params.dt);
+        var m = 0.0;
+        if (params.rolling_k > 0.0) {
+            // The rolling spring, kept among the slot's SubSprings (ROLLING_KEY).
+            let old = sub_hist[slot];
+            var spring = 0.0;
+            if (old.key.x == ROLLING_KEY) { spring = old.xi.x; }
+            let r = rolling_spring(spring, spin, r_roll, res.f_n, inv_rolling, params.dt);
+            m = r.x;
+            sub_hist[slot] = SubSprings(vec4<u32>(ROLLING_KEY, EMPTY, EMPTY, EMPTY),
+                                        vec4<f32>(r.y, 0.0, 0.0, 0.0));
+        } else {
+            m = rolling_torque(params.rolling_mu, spin, r_roll, res.f_n, inv_inertia, params.dt);
+        }
         torques += vec2<f32>(m, -m);
     }
     contact_ft[slot] = vec4<f32>(f, torques);

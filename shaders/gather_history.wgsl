@@ -43,14 +43,15 @@ fn sort_down_list(p: u32) {
 fn gather_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= live() || halted() || !rebuilding()) { return; }
-    let swept = params.law == LAW_HERTZ;
+    let swept = sub_springs_kept();
     for (var k = 0u; k < contact_count[i]; k++) {
         let slot = i * params.list_cap + k;
         let e = find_entry(ids[i], partner_key(contact_j[slot]));
         var value = 0.0;
         if (e != EMPTY) { value = table[e].value; }
         hist_in[slot] = value;
-        // A spheropolygon pair's springs are its sub-contacts' (`table_sub`).
+        // A spheropolygon pair's springs are its sub-contacts', a disk pair's rolling
+        // spring beside its tangential one (`table_sub`).
         if (swept) {
             var sub = SubSprings(vec4<u32>(EMPTY), vec4<f32>(0.0));
             if (e != EMPTY) { sub = table_sub[e]; }

@@ -42,12 +42,13 @@ fn insert(i: u32, j: u32, value: f32, owner: u32) -> u32 {
 fn store_history(@builtin(global_invocation_id) gid: vec3<u32>) {
     let i = gid.x;
     if (i >= live() || halted() || !storing()) { return; }
-    let swept = params.law == LAW_HERTZ;
+    let swept = sub_springs_kept();
     for (var k = 0u; k < contact_count[i]; k++) {
         let slot = i * params.list_cap + k;
         if (touching[slot] != 0u) {
             let e = insert(ids[i], partner_key(contact_j[slot]), hist_in[slot], i);
-            // A spheropolygon pair's sub-contact springs go beside the entry.
+            // A spheropolygon pair's sub-contact springs (a disk pair's rolling
+            // spring) go beside the entry.
             if (swept && e != EMPTY) { table_sub[e] = sub_hist[slot]; }
         }
     }

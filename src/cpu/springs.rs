@@ -122,9 +122,12 @@ pub fn store_history(pairs: &[Pair], values: &[f64], table: &mut SpringTable) {
 /// touching at many points) the shallowest sub-contacts' springs restart every step.
 pub const MAX_SUB: usize = 4;
 
-/// One pair's tangential springs, each keyed by its sub-contact (`SubContact::key`):
-/// what the neighbour list's slot holds for a spheropolygon pair between steps (SPEC 3:
-/// "keyed by the pair and the sub-contact").
+/// One pair's springs beyond its tangential one, each keyed: a spheropolygon pair's
+/// sub-contacts' tangential springs (by `SubContact::key`; SPEC 3: "keyed by the pair
+/// and the sub-contact"), or a disk pair's rolling spring (`ROLLING_KEY`,
+/// src/law/rolling.rs; rods take no rolling resistance, so the two never meet). What
+/// the neighbour list's slot holds between steps, and the spring table and checkpoints
+/// beside the tangential spring.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SubSprings {
     pub count: usize,
@@ -132,7 +135,19 @@ pub struct SubSprings {
     pub xi: [f64; MAX_SUB],
 }
 
+/// The key of a disk pair's rolling spring among its `SubSprings`: no sub-contact's key
+/// (those are below 2¹⁸, `overlap::spheropolygon::VERTICES` and two 8-bit indices), nor
+/// the GPU's empty key (u32::MAX).
+pub const ROLLING_KEY: u32 = u32::MAX - 1;
+
 impl SubSprings {
+    /// A disk pair's rolling spring alone.
+    pub fn rolling(m_k: f64) -> Self {
+        let mut s = Self::default();
+        s.push(ROLLING_KEY, m_k);
+        s
+    }
+
     /// The spring of a sub-contact, 0 for one that was not there at the last step.
     pub fn get(&self, key: u32) -> f64 {
         (0..self.count)

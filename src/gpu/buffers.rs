@@ -121,9 +121,13 @@ impl Buffers {
             props_next: zeroed("props_next", n * size_of::<Props>() as u64),
             ids_next: zeroed("ids_next", n * 4),
             table: init("springs", bytemuck::cast_slice(c.table)),
-            // Only spheropolygon scenes use them (32 bytes a slot).
+            // Only spheropolygon scenes and rolling springs use them (32 bytes a slot).
             sub_hist: {
-                let slots = if params.law == LAW_HERTZ { n * m } else { 1 };
+                let slots = if super::params_keep_sub_springs(params) {
+                    n * m
+                } else {
+                    1
+                };
                 let empty = vec![SubSprings::default(); slots as usize];
                 init("sub_hist", bytemuck::cast_slice(&empty))
             },

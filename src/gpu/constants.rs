@@ -76,6 +76,7 @@ pub fn shared() -> Vec<(&'static str, Value)> {
         u("MAX_WORKGROUPS", super::MAX_WORKGROUPS),
         u("WALL_BASE", crate::cpu::contacts::WALL_BASE),
         u("EMPTY", layout::EMPTY),
+        u("ROLLING_KEY", crate::cpu::springs::ROLLING_KEY),
         u("LAW_SPRING_DASHPOT", layout::LAW_SPRING_DASHPOT),
         u("LAW_CONTINUOUS", layout::LAW_CONTINUOUS),
         u("LAW_AREA", layout::LAW_AREA),

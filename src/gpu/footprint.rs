@@ -8,7 +8,6 @@ use super::buckets::bucket_count;
 use super::layout::{Candidate, Entry, State, SubSprings};
 use super::{MAX_CELLS_PER_SIDE, MAX_CONTACTS, MAX_WORKGROUPS, WG};
 use crate::create;
-use crate::law::ContactLaw;
 use crate::sim::Simulation;
 
 /// The particles a scene's run holds at most, its candidates per particle and the bytes
@@ -57,7 +56,8 @@ impl Footprint {
 }
 
 /// The footprint of `n` particles, `to_come` of them still to be drawn by point sources,
-/// with `list_cap` candidates each (`swept`: and the sub-contact springs of rods), on a
+/// with `list_cap` candidates each (`swept`: and the sub-contact springs of rods, or
+/// the rolling springs of disks), on a
 /// grid of `cells` (buckets).
 pub fn of_count(n: u64, to_come: u64, list_cap: u32, swept: bool, cells: u64) -> Footprint {
     let mut buffers = vec![
@@ -109,7 +109,7 @@ pub fn footprint(sim: &Simulation) -> Footprint {
         .max(1);
     let grid = sim.grid.coarsened(sim.grid.cell_size + sim.skin());
     let cells = bucket_count(&grid, n.min(u32::MAX as u64) as u32);
-    let swept = matches!(sim.law, ContactLaw::HertzCohesive(_));
+    let swept = super::keeps_sub_springs(sim);
     Footprint {
         grid: [grid.nx, grid.nz],
         ..of_count(n, to_come, super::list_capacity(sim), swept, cells)

@@ -147,9 +147,14 @@ pub struct Params {
     /// The continuous law's readings of paper 001 (src/law/continuous.rs `Reading`):
     /// `READING_SLIP_DAMPING` | `READING_CONTACT_ARM`, 0 for the paper's text.
     pub reading: u32,
-    /// Rolling resistance at disk contacts (src/law/rolling.rs): μ_r, 0 for none.
+    /// Rolling resistance at disk contacts (src/law/rolling.rs): μ_r, 0 for none; the
+    /// spring model's k_roll (0: the constant torque) and η_r.
     pub rolling_mu: f32,
-    pub pad_pair2: u32,
+    pub rolling_k: f32,
+    pub rolling_eta: f32,
+    pub pad_roll0: u32,
+    pub pad_roll1: u32,
+    pub pad_roll2: u32,
     /// Slot s = a · pair_side + b of materials a and b (b = pair_side − 1: a wall):
     /// `pair_law[2s]` = (k_n, γ_n, k_t, γ_t), `pair_law[2s + 1].x` = μ.
     pub pair_law: [[f32; 4]; 2 * MAX_PAIR_SLOTS],
@@ -357,7 +362,11 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 per_mass,
                 reading,
                 rolling_mu,
-                pad_pair2,
+                rolling_k,
+                rolling_eta,
+                pad_roll0,
+                pad_roll1,
+                pad_roll2,
                 pair_law
             ]
         ),

@@ -253,6 +253,18 @@ fn unsupported_spheropolygons(sim: &Simulation) -> Option<String> {
     })
 }
 
+/// Whether the scene keeps `SubSprings` per candidate slot and table entry (`sub_hist`,
+/// `table_sub`): spheropolygons' sub-contact springs, or disk pairs' rolling springs
+/// (rolling model `spring_dashpot`). WGSL twin: `sub_springs_kept` in common.wgsl.
+pub(crate) fn keeps_sub_springs(sim: &crate::sim::Simulation) -> bool {
+    matches!(sim.law, ContactLaw::HertzCohesive(_)) || sim.rolling.has_spring()
+}
+
+/// `keeps_sub_springs` from the device's parameters.
+pub(crate) fn params_keep_sub_springs(params: &Params) -> bool {
+    params.law == LAW_HERTZ || params.rolling_k > 0.0
+}
+
 /// Whether `contact_forces` takes a thread per pair (the overlap-area law and
 /// spheropolygons: `POLYGONS`, `SPHEROPOLYGONS`) rather than one per particle.
 pub(crate) fn per_pair(params: &Params) -> bool {
@@ -350,9 +362,9 @@ impl GpuSimulation {
         state_all[..states.len()].copy_from_slice(&states);
         let mut props_all = vec![Props::default(); n_cap as usize];
         props_all[..props.len()].copy_from_slice(&props);
-        let swept = matches!(sim.law, ContactLaw::HertzCohesive(_));
+        let kept = keeps_sub_springs(&sim);
         let (table, table_sub) =
-            transfer::build_tables(&entries, swept.then_some(&subs[..]), table_cap as usize);
+            transfer::build_tables(&entries, kept.then_some(&subs[..]), table_cap as usize);
 
         let mut corners = device_corners(
             &up.corner_table,

@@ -211,6 +211,12 @@ pub(super) fn step_params(
         list_cap: super::list_capacity(sim),
         max_step2: sim.scene.limits.max_step_displacement.powi(2) as f32,
         rolling_mu: sim.rolling.mu_r as f32,
+        rolling_k: if sim.rolling.has_spring() {
+            sim.rolling.k_roll as f32
+        } else {
+            0.0
+        },
+        rolling_eta: sim.rolling.eta_r as f32,
         ..Default::default()
     };
     law_params(law, &mut params);

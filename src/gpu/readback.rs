@@ -161,6 +161,8 @@ impl GpuSimulation {
                         f_t: o.info[1] as f64,
                         overlap: o.info[2] as f64,
                         energy: o.info[3] as f64,
+                        // The rolling springs come back with the spring table.
+                        rolling: 0.0,
                     },
                 ));
             }
@@ -218,8 +220,9 @@ impl GpuSimulation {
         let cap = self.params.table_mask as usize + 1;
         self.flush_table();
         let table: Vec<Entry> = self.read_buffer(&self.buffers.table, 0, cap);
-        // Spheropolygons: each entry's sub-contact springs, from beside it.
-        let swept = self.params.law == LAW_HERTZ;
+        // Spheropolygons' sub-contact springs, disks' rolling springs: from beside each
+        // entry.
+        let swept = super::params_keep_sub_springs(&self.params);
         let subs: Vec<SubSprings> = if swept {
             self.read_buffer(&self.buffers.table_sub, 0, cap)
         } else {

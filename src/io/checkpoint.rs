@@ -108,10 +108,11 @@ pub fn encode(sim: &Simulation, device: Option<&DeviceState>) -> Vec<u8> {
         }
         None => e.u8(0),
     }
-    // Spheropolygons (rods), only when the state has some, so that other checkpoints
-    // stay as they were: a tag, each particle's sweep, and each pair's sub-contact
-    // springs (pair key, count, then the count's keys and values).
-    if p.sweep.iter().any(|&s| s > 0.0) {
+    // Spheropolygons (rods) or rolling springs, only when the state has some, so that
+    // other checkpoints stay as they were: a tag, each particle's sweep, and each pair's
+    // `SubSprings` (pair key, count, then the count's keys and values).
+    let subs = !springs.sub.is_empty() || device.is_some_and(|d| !d.sub.is_empty());
+    if subs || p.sweep.iter().any(|&s| s > 0.0) {
         e.u8(SWEPT);
         p.sweep.iter().for_each(|&v| e.f64(v));
         e.u64(springs.sub.len() as u64);
@@ -148,7 +149,8 @@ fn checksum(bytes: &[u8]) -> u64 {
 }
 
 /// The tags of the optional sections at a checkpoint's end, in this order: the
-/// spheropolygons', then the copies'.
+/// spheropolygons' (and any pair's `SubSprings`: rolling springs too), then the
+/// copies'.
 const SWEPT: u8 = 1;
 const REPLICAS: u8 = 2;
 

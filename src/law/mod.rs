@@ -211,6 +211,16 @@ impl ContactLaw {
         }
     }
 
+    /// The law's one linear normal stiffness k_n (N/m): the spring–dashpot's stiffness
+    /// form with ν = 1. None where the stiffness varies by pair, with the overlap or with
+    /// the distance (the default of a rolling spring's stiffness, src/law/rolling.rs).
+    pub fn linear_k_n(&self) -> Option<f64> {
+        match self {
+            Self::SpringDashpot(l) if l.pairs.is_none() && l.nu == 1.0 => Some(l.k_n),
+            _ => None,
+        }
+    }
+
     pub fn mu(&self) -> f64 {
         match self {
             Self::SpringDashpot(l) => l.mu,

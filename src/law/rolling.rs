@@ -13,8 +13,17 @@
 //! or a wall counted as infinitely heavy; `AT_REST`), so a contact that has stopped
 //! rolling comes to rest instead of chattering. What the model cannot do is hold a
 //! torque below μ_r R* f_n still: there it acts as that viscous torque, and the
-//! contact creeps at ω_r ≈ 10 τ dt / I*. The elastic–plastic spring–dashpot (model C),
-//! which keeps a rolling spring in the contact history and holds, is not done yet.
+//! contact creeps at ω_r ≈ 10 τ dt / I*.
+//!
+//! The elastic–plastic spring–dashpot (model C of Ai et al., their eq. 9–16; LIGGGHTS
+//! `epsd`/`epsd3`, LAMMPS `rolling sds`) holds such a torque: a rolling spring
+//! M_k ← M_k − k_r ω_r dt kept in the contact's history like the tangential spring,
+//! limited to the same μ_r R* f_n, with a dashpot −C_r ω_r while the spring holds
+//! (none at full mobilisation, Ai et al.'s f = 0), C_r = η_r 2 sqrt(I_r k_r) and
+//! 1/I_r = 1/(I_i + m_i R_i²) + 1/(I_j + m_j R_j²) (their eq. 16: each disk about the
+//! contact point). The angular stiffness is k_r = k_roll R*², k_roll a stiffness per
+//! unit of rolled length R* θ_r (LAMMPS `k_roll`); Ai et al.'s eq. 13 (and LIGGGHTS
+//! `epsd`) take k_roll = 2.25 μ_r² k_n.
 
 use serde::{Deserialize, Serialize};
 
@@ -22,12 +31,21 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RollingSpec {
-    /// Which model (only `constant_torque` so far).
+    /// Which model: `constant_torque` (default) or `spring_dashpot`.
     #[serde(default)]
     pub model: RollingModel,
     /// The coefficient of rolling resistance μ_r (dimensionless: the lever of the normal
     /// force is μ_r R*).
     pub mu_r: f64,
+    /// `spring_dashpot` only: k_roll, the rolling spring's force per unit of rolled
+    /// length (N/m, like k_n; the angular stiffness is k_roll R*²). Default 2.25 μ_r² k_n
+    /// (Ai et al. eq. 13) under a law with one k_n; required under the others.
+    #[serde(default)]
+    pub stiffness: Option<f64>,
+    /// `spring_dashpot` only: η_r, the dashpot's fraction of critical damping
+    /// (default 0.3, Ai et al.'s choice).
+    #[serde(default)]
+    pub damping: Option<f64>,
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -36,23 +54,62 @@ pub enum RollingModel {
     /// Model A of Ai et al. (2011): |M_r| = μ_r R* f_n against the relative spin.
     #[default]
     ConstantTorque,
+    /// Model C of Ai et al. (2011): a rolling spring and dashpot, plastic at μ_r R* f_n.
+    SpringDashpot,
 }
 
-/// The resolved rolling resistance of a run: μ_r, 0 for none.
+/// k_roll / (μ_r² k_n) when the scene does not give `stiffness` (Ai et al. eq. 13).
+pub const DEFAULT_STIFFNESS_FACTOR: f64 = 2.25;
+
+/// η_r when the scene does not give `damping` (Ai et al. sec. 2.3).
+pub const DEFAULT_DAMPING: f64 = 0.3;
+
+/// The resolved rolling resistance of a run: μ_r (0 for none), and for the spring model
+/// k_roll > 0 and η_r (k_roll = 0: the constant torque).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Rolling {
     pub mu_r: f64,
+    pub k_roll: f64,
+    pub eta_r: f64,
 }
 
 impl Rolling {
-    pub const NONE: Rolling = Rolling { mu_r: 0.0 };
+    pub const NONE: Rolling = Rolling {
+        mu_r: 0.0,
+        k_roll: 0.0,
+        eta_r: 0.0,
+    };
 
-    pub fn of(spec: Option<&RollingSpec>) -> Rolling {
-        spec.map_or(Rolling::NONE, |s| Rolling { mu_r: s.mu_r })
+    /// The scene's block resolved; `k_n`: the law's one normal stiffness, if it has one
+    /// (the spring's default). None: a spring without a stiffness to take (the scene's
+    /// validation names the key).
+    pub fn of(spec: Option<&RollingSpec>, k_n: Option<f64>) -> Option<Rolling> {
+        let Some(s) = spec else {
+            return Some(Rolling::NONE);
+        };
+        Some(match s.model {
+            RollingModel::ConstantTorque => Rolling {
+                mu_r: s.mu_r,
+                ..Rolling::NONE
+            },
+            RollingModel::SpringDashpot => Rolling {
+                mu_r: s.mu_r,
+                k_roll: match s.stiffness {
+                    Some(k) => k,
+                    None => DEFAULT_STIFFNESS_FACTOR * s.mu_r * s.mu_r * k_n?,
+                },
+                eta_r: s.damping.unwrap_or(DEFAULT_DAMPING),
+            },
+        })
     }
 
     pub fn is_none(&self) -> bool {
         self.mu_r == 0.0
+    }
+
+    /// Whether contacts keep a rolling spring (the spring–dashpot model).
+    pub fn has_spring(&self) -> bool {
+        !self.is_none() && self.k_roll > 0.0
     }
 }
 
@@ -88,6 +145,50 @@ pub fn rolling_torque(
     -full.min(near_rest).copysign(spin)
 }
 
+/// The spring–dashpot rolling torque on disk i (j takes its opposite) and the rolling
+/// spring after the step (Ai et al. 2011 eq. 9–16), from the spring before it, the
+/// relative spin `spin` = ω_i − ω_j, the rolling radius R*, the normal force (a pull
+/// resists nothing) and 1/I_r (`rolling_inertia_inv` summed over the disks; 0: both
+/// fixed, nothing to resist). Twin of `rolling_spring` in shaders/contact_forces.wgsl.
+#[inline(always)]
+pub fn rolling_spring(
+    r: &Rolling,
+    spring: f64,
+    spin: f64,
+    r_roll: f64,
+    f_n: f64,
+    inv_rolling_inertia: f64,
+    dt: f64,
+) -> (f64, f64) {
+    if !(inv_rolling_inertia > 0.0) {
+        return (0.0, 0.0);
+    }
+    let k_r = r.k_roll * r_roll * r_roll;
+    // Eq. 11: the full mobilisation torque, the spring's plastic limit.
+    let limit = r.mu_r * r_roll * f_n.max(0.0);
+    // Eq. 9: the spring follows the relative rotation of the step.
+    let m_k = spring - k_r * spin * dt;
+    if m_k.abs() >= limit {
+        // Full mobilisation: the spring slips at its limit, no damping (f = 0).
+        let m_k = if m_k == 0.0 { 0.0 } else { limit.copysign(m_k) };
+        return (m_k, m_k);
+    }
+    // Eq. 14–15: the dashpot at η_r of critical damping about the contact point.
+    let c_r = r.eta_r * 2.0 * (k_r / inv_rolling_inertia).sqrt();
+    (m_k - c_r * spin, m_k)
+}
+
+/// 1/(I + m R²): a disk's part of 1/I_r (its inertia about the contact point, Ai et al.
+/// eq. 16); 0 for a fixed disk.
+#[inline(always)]
+pub fn rolling_inertia_inv(inertia: f64, mass: f64, radius: f64, fixed: bool) -> f64 {
+    if fixed {
+        0.0
+    } else {
+        1.0 / (inertia + mass * radius * radius)
+    }
+}
+
 /// R* = R_i R_j / (R_i + R_j) of two disks, R_i against a wall (`r_j` None).
 #[inline(always)]
 pub fn rolling_radius(r_i: f64, r_j: Option<f64>) -> f64 {
@@ -119,6 +220,56 @@ mod tests {
         assert_eq!(rolling_torque(0.1, 0.0, 0.5, 3.0, 1.0, 1e-4), 0.0);
         // Both fixed: nothing to resist.
         assert_eq!(rolling_torque(0.1, 1.0, 0.5, 3.0, 0.0, 1e-4), 0.0);
+    }
+
+    fn spring(k_roll: f64) -> Rolling {
+        Rolling {
+            mu_r: 0.1,
+            k_roll,
+            eta_r: 0.3,
+        }
+    }
+
+    #[test]
+    fn the_spring_winds_up_against_the_spin_and_slips_at_its_limit() {
+        let r = spring(100.0);
+        // k_r = 100 · 0.5² = 25; one step of spin 2 at dt 1e-3 winds it by −0.05.
+        let (m, s) = rolling_spring(&r, 0.0, 2.0, 0.5, 10.0, 1.0, 1e-3);
+        assert!((s + 25.0 * 2.0 * 1e-3).abs() < 1e-15, "{s}");
+        // The dashpot 0.3 · 2 sqrt(25 / 1) = 3 against the spin of 2.
+        assert!((m - (s - 3.0 * 2.0)).abs() < 1e-12, "{m}");
+        // Beyond μ_r R* f_n = 0.5 the spring slips, without the dashpot.
+        let (m, s) = rolling_spring(&r, -0.49, 2.0, 0.5, 10.0, 1.0, 1e-3);
+        assert_eq!((m, s), (-0.5, -0.5));
+        // A pull resists nothing; both disks fixed, nothing to resist.
+        assert_eq!(
+            rolling_spring(&r, -0.3, 2.0, 0.5, -1.0, 1.0, 1e-3),
+            (0.0, 0.0)
+        );
+        assert_eq!(
+            rolling_spring(&r, -0.3, 2.0, 0.5, 10.0, 0.0, 1e-3),
+            (0.0, 0.0)
+        );
+    }
+
+    #[test]
+    fn the_default_stiffness_is_ai_et_al_and_needs_a_k_n() {
+        let spec = RollingSpec {
+            model: RollingModel::SpringDashpot,
+            mu_r: 0.2,
+            stiffness: None,
+            damping: None,
+        };
+        let r = Rolling::of(Some(&spec), Some(1e4)).unwrap();
+        assert!((r.k_roll - 2.25 * 0.04 * 1e4).abs() < 1e-9);
+        assert_eq!(r.eta_r, DEFAULT_DAMPING);
+        assert!(r.has_spring());
+        assert_eq!(Rolling::of(Some(&spec), None), None);
+        let cdt = RollingSpec {
+            model: RollingModel::ConstantTorque,
+            ..spec
+        };
+        assert!(!Rolling::of(Some(&cdt), None).unwrap().has_spring());
     }
 
     #[test]

@@ -425,29 +425,60 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
 
     let law = ContactLaw::of_scene(scene)?;
     spheropolygons(scene, &law)?;
-    rolling(scene)?;
+    rolling(scene, &law)?;
     warnings.extend(super::stability::time_step(scene, &law)?);
     Ok(Checked { law, warnings })
 }
 
 /// Rolling resistance (src/law/rolling.rs) acts at disk contacts: under the disk laws,
 /// which take disks only (polygons need the overlap-area law, rods `hertz_cohesive`).
-fn rolling(scene: &Scene) -> Result<(), SceneError> {
+/// The spring model's keys belong to it, and its stiffness must be given where the law
+/// has no one k_n to take it from.
+fn rolling(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
+    use crate::law::rolling::RollingModel;
     let Some(r) = &scene.rolling else {
         return Ok(());
     };
     finite_non_negative("rolling.mu_r", r.mu_r)?;
-    let law = match scene.contact {
-        ContactSpec::OverlapArea(_) => "overlap_area",
-        ContactSpec::HertzCohesive(_) => "hertz_cohesive",
-        _ => return Ok(()),
+    let name = match scene.contact {
+        ContactSpec::OverlapArea(_) => Some("overlap_area"),
+        ContactSpec::HertzCohesive(_) => Some("hertz_cohesive"),
+        _ => None,
     };
-    Err(SceneError::invalid(
-        "rolling",
-        format!(
-            "rolling resistance acts at disk contacts under the laws spring_dashpot, continuous and hooke_equivalent, not under \"{law}\" (polygons and rods resist rolling by their shape)"
-        ),
-    ))
+    if let Some(name) = name {
+        return Err(SceneError::invalid(
+            "rolling",
+            format!(
+                "rolling resistance acts at disk contacts under the laws spring_dashpot, continuous and hooke_equivalent, not under \"{name}\" (polygons and rods resist rolling by their shape)"
+            ),
+        ));
+    }
+    match r.model {
+        RollingModel::ConstantTorque => {
+            for (key, given) in [("stiffness", r.stiffness), ("damping", r.damping)] {
+                if given.is_some() {
+                    return Err(SceneError::invalid(
+                        format!("rolling.{key}"),
+                        "belongs to the model \"spring_dashpot\" (the constant torque has no spring)",
+                    ));
+                }
+            }
+        }
+        RollingModel::SpringDashpot => {
+            if let Some(k) = r.stiffness {
+                finite_positive("rolling.stiffness", k)?;
+            } else if law.linear_k_n().is_none() {
+                return Err(SceneError::invalid(
+                    "rolling.stiffness",
+                    "is required here: its default, 2.25 mu_r² k_n (Ai et al. 2011), needs the law's one linear k_n (law spring_dashpot with k_n and nu = 1)",
+                ));
+            }
+            if let Some(eta) = r.damping {
+                finite_non_negative("rolling.damping", eta)?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Rods (spheropolygons) and law `hertz_cohesive` go together (issue 15): rods need the

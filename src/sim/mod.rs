@@ -169,7 +169,8 @@ impl Simulation {
         let max_d = crate::scene::max_diameter(&scene).max(2.0 * particles.max_radius());
         let grid = Grid::new(scene.domain.x, scene.domain.z, law.range_factor() * max_d);
         Ok(Self {
-            rolling: Rolling::of(scene.rolling.as_ref()),
+            // Validated: a spring has its stiffness (`scene::validate`).
+            rolling: Rolling::of(scene.rolling.as_ref(), law.linear_k_n()).unwrap_or(Rolling::NONE),
             scene,
             law,
             walls,

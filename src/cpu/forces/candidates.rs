@@ -9,8 +9,7 @@ use super::{ContactForce, StepState, contact_force};
 use crate::base::geometry::Geometry;
 use crate::cpu::contacts::Pair;
 use crate::cpu::neighbours::{NeighbourList, id_pair};
-use crate::cpu::springs::SubSprings;
-use crate::cpu::springs::pair_key;
+use crate::cpu::springs::{ROLLING_KEY, SubSprings, pair_key};
 use crate::law::{ContactLaw, Law};
 use crate::overlap::{AreaContact, Hint, polygon_polygon_hinted};
 use crate::state::Particles;
@@ -20,14 +19,16 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// One candidate of the neighbour list: its contact force and updated history if the
 /// pair touches (the test of `contacts::find_contacts`, with the geometry computed once:
 /// the disks' for the disk laws, the overlap for polygons), None if it does not.
+/// `rolling`: its rolling spring before the step (rolling model `spring_dashpot`).
 #[inline(always)]
 pub fn candidate_force<L: Law>(
     s: &StepState,
     law: &L,
     pair: Pair,
     history: f64,
+    rolling: f64,
 ) -> Option<(ContactForce, f64)> {
-    candidate_force_hinted(s, law, pair, history, Hint::NONE).0
+    candidate_force_hinted(s, law, pair, history, rolling, Hint::NONE).0
 }
 
 /// [`candidate_force`] from the candidate's hint of its last evaluation (polygon pairs,
@@ -39,6 +40,7 @@ pub fn candidate_force_hinted<L: Law>(
     law: &L,
     pair: Pair,
     history: f64,
+    rolling: f64,
     hint: Hint,
 ) -> (Option<(ContactForce, f64)>, Hint) {
     let (g, input, hint) = if L::AREA {
@@ -55,7 +57,7 @@ pub fn candidate_force_hinted<L: Law>(
         let (g, input) = disk_kinematics(s, pair, history, g, d);
         (g, input, Hint::NONE)
     };
-    let r = contact_force(s, |c| law.evaluate(c), pair, &g, &input);
+    let r = contact_force(s, |c| law.evaluate(c), pair, &g, &input, rolling);
     (Some(r), hint)
 }
 
@@ -82,10 +84,11 @@ pub(super) fn disk_candidate_force<L: Law>(
     law: &L,
     pair: Pair,
     history: f64,
+    rolling: f64,
     (g, d): (Geometry, Option<[f64; 2]>),
 ) -> (ContactForce, f64) {
     let (g, input) = disk_kinematics(s, pair, history, g, d);
-    contact_force(s, |c| law.evaluate(c), pair, &g, &input)
+    contact_force(s, |c| law.evaluate(c), pair, &g, &input, rolling)
 }
 
 /// Candidates of a disk law evaluated per block, each half for the whole block at once.
@@ -193,6 +196,16 @@ pub(super) fn candidates_with<L: Law>(
     out.kicks.resize(n, Kick::default());
     out.history.resize(n, 0.0);
     out.contacts.clear();
+    // Each candidate's rolling spring before the step (model `spring_dashpot`), kept
+    // among its `SubSprings`; 0 for all in a list that has none yet.
+    let springs = s.rolling.has_spring();
+    let rolling = |k: usize| match list.sub_history.get(k) {
+        Some(sub) if springs && list.sub_history.len() == n => sub.get(ROLLING_KEY),
+        _ => 0.0,
+    };
+    if !springs {
+        out.sub_history.clear();
+    }
     // The first diverging candidate by pair of ids (the same whatever the memory order
     // and whichever thread finds it).
     let first = AtomicU64::new(u64::MAX);
@@ -207,11 +220,30 @@ pub(super) fn candidates_with<L: Law>(
     };
     let evaluate = |k: usize, kick: &mut Kick, h: &mut f64| {
         let hint = list.hints.get(k);
-        let (r, hint) = candidate_force_hinted(s, law, list.pairs[k], list.history[k], hint);
+        let (r, hint) =
+            candidate_force_hinted(s, law, list.pairs[k], list.history[k], rolling(k), hint);
         list.hints.set(k, hint);
         settle(k, r, kick, h)
     };
-    if record {
+    if springs {
+        // Rolling springs: each candidate's contact kept whole, for its spring (a
+        // scene with them takes this plainer loop, recording or not).
+        let mut contacts: Vec<Option<ContactForce>> = vec![None; n];
+        let mut kh: Vec<(Kick, f64)> = vec![(Kick::default(), 0.0); n];
+        crate::base::parallel::for_each2(&mut contacts, &mut kh, |k, c, (kick, h)| {
+            *c = evaluate(k, kick, h);
+        });
+        out.sub_history.clear();
+        for (k, ((kick, h), c)) in kh.into_iter().zip(&contacts).enumerate() {
+            out.kicks[k] = kick;
+            out.history[k] = h;
+            out.sub_history
+                .push(c.map_or_else(SubSprings::default, |c| SubSprings::rolling(c.rolling)));
+        }
+        if record {
+            out.contacts = contacts;
+        }
+    } else if record {
         out.contacts.resize(n, None);
         let mut kh: Vec<(Kick, f64)> = vec![(Kick::default(), 0.0); n];
         crate::base::parallel::for_each2(&mut out.contacts, &mut kh, |k, c, (kick, h)| {
@@ -230,8 +262,8 @@ pub(super) fn candidates_with<L: Law>(
             }
             for (m, (kick, h)) in kicks.iter_mut().zip(h).enumerate() {
                 let k = k0 + m;
-                let r =
-                    geometry[m].map(|g| disk_candidate_force(s, law, pairs[m], list.history[k], g));
+                let r = geometry[m]
+                    .map(|g| disk_candidate_force(s, law, pairs[m], list.history[k], 0.0, g));
                 settle(k, r, kick, h);
             }
         };
@@ -253,7 +285,7 @@ pub(super) fn candidates_with<L: Law>(
                 let k = k0 + m;
                 let r = geometry[m].map(|c| {
                     let (g, input) = area_kinematics(s, pairs[m], list.history[k], c);
-                    contact_force(s, |c| law.evaluate(c), pairs[m], &g, &input)
+                    contact_force(s, |c| law.evaluate(c), pairs[m], &g, &input, 0.0)
                 });
                 settle(k, r, kick, h);
             }
@@ -265,7 +297,7 @@ pub(super) fn candidates_with<L: Law>(
         let k = (list.pairs.iter())
             .position(|&p| pair_key(id_pair(p, ids)) == key)
             .expect("the diverging pair is a candidate");
-        let c = candidate_force(s, law, list.pairs[k], list.history[k]);
+        let c = candidate_force(s, law, list.pairs[k], list.history[k], rolling(k));
         (k, c.expect("a diverging candidate is a contact").0)
     });
 }

@@ -10,7 +10,9 @@
 use crate::base::geometry::{Geometry, WallSegment, tangent};
 use crate::cpu::contacts::Pair;
 use crate::cpu::orientation::RotatedCorners;
-use crate::law::rolling::{Rolling, rolling_radius, rolling_torque};
+use crate::law::rolling::{
+    Rolling, rolling_inertia_inv, rolling_radius, rolling_spring, rolling_torque,
+};
 use crate::law::{ContactInput, ContactLaw, ContactOutput};
 use crate::state::{Dof, Particles, offset};
 
@@ -48,6 +50,8 @@ pub struct ContactForce {
     pub overlap: f64,
     /// Elastic energy stored in the contact.
     pub energy: f64,
+    /// The rolling spring after this step (rolling model `spring_dashpot`; else 0).
+    pub rolling: f64,
 }
 
 /// What every contact of a step reads: the state, each particle's velocity (q1/dt,
@@ -73,7 +77,9 @@ pub fn velocities(particles: &Particles, dt: f64, out: &mut Vec<Dof>) {
     crate::base::parallel::for_each(out, |i, v| *v = particles.velocity(i, dt));
 }
 
-/// Stage: forces of every contact, and the updated tangential history.
+/// Stage: forces of every contact, and the updated tangential history. Each contact's
+/// rolling spring (model `spring_dashpot`) starts afresh: this stage keeps no list
+/// (the GPU kernels' tests use it on contacts that have just formed).
 #[allow(clippy::too_many_arguments)]
 pub fn contact_forces(
     particles: &Particles,
@@ -105,14 +111,15 @@ pub fn contact_forces(
     let area = matches!(law, ContactLaw::OverlapArea(_));
     for (&pair, &history) in pairs.iter().zip(history_in) {
         let (g, input) = contact_input(&s, area, pair, history);
-        let (c, h) = contact_force(&s, |c| law.evaluate(c), pair, &g, &input);
+        let (c, h) = contact_force(&s, |c| law.evaluate(c), pair, &g, &input, 0.0);
         out.push(c);
         history_out.push(h);
     }
 }
 
 /// The law applied to one contact's geometry and kinematics: the force on i and the
-/// updated history.
+/// updated history. `rolling_spring`: the contact's rolling spring before the step
+/// (model `spring_dashpot`; its update is `ContactForce::rolling`).
 #[inline(always)]
 pub(super) fn contact_force(
     s: &StepState,
@@ -120,6 +127,7 @@ pub(super) fn contact_force(
     pair: Pair,
     g: &Geometry,
     input: &ContactInput,
+    rolling_spring: f64,
 ) -> (ContactForce, f64) {
     let particles = s.particles;
     let res = evaluate(input);
@@ -135,9 +143,11 @@ pub(super) fn contact_force(
         [g.arm[0] + d[0], g.arm[1] + d[1]]
     });
     let mut torque = res.torques(force, g.arm, arm_j);
+    let mut spring = 0.0;
     if !s.rolling.is_none() {
         // On i, and its opposite on j (whose torque is −torque[1]).
-        let m = rolling(s, pair, res.f_n);
+        let m;
+        (m, spring) = rolling(s, pair, res.f_n, rolling_spring);
         torque = [torque[0] + m, torque[1] + m];
     }
     let c = ContactForce {
@@ -150,34 +160,28 @@ pub(super) fn contact_force(
         f_t: res.f_t,
         overlap: g.delta,
         energy: res.energy,
+        rolling: spring,
     };
     (c, res.history)
 }
 
 /// The rolling torque on disk i of a disk contact (src/law/rolling.rs), j taking its
-/// opposite; f_n: the contact's normal force.
+/// opposite, and the rolling spring after the step (0 without one); f_n: the contact's
+/// normal force, `spring`: the rolling spring before the step.
 #[inline(always)]
-fn rolling(s: &StepState, pair: Pair, f_n: f64) -> f64 {
+fn rolling(s: &StepState, pair: Pair, f_n: f64, spring: f64) -> (f64, f64) {
     let p = s.particles;
     let i = pair.i as usize;
+    let j = (!pair.is_wall()).then_some(pair.j as usize);
+    let spin = s.velocity[i][2] - j.map_or(0.0, |j| s.velocity[j][2]);
+    let r_roll = rolling_radius(p.radius[i], j.map(|j| p.radius[j]));
+    if s.rolling.has_spring() {
+        let inv = |k: usize| rolling_inertia_inv(p.inertia[k], p.mass[k], p.radius[k], p.fixed[k]);
+        let inv_r = inv(i) + j.map_or(0.0, inv);
+        return rolling_spring(&s.rolling, spring, spin, r_roll, f_n, inv_r, s.dt);
+    }
     let inv_inertia = |k: usize| if p.fixed[k] { 0.0 } else { 1.0 / p.inertia[k] };
-    let (spin, r_j, inv_j) = if pair.is_wall() {
-        (s.velocity[i][2], None, 0.0)
-    } else {
-        let j = pair.j as usize;
-        (
-            s.velocity[i][2] - s.velocity[j][2],
-            Some(p.radius[j]),
-            inv_inertia(j),
-        )
-    };
-    let r_roll = rolling_radius(p.radius[i], r_j);
-    rolling_torque(
-        s.rolling.mu_r,
-        spin,
-        r_roll,
-        f_n,
-        inv_inertia(i) + inv_j,
-        s.dt,
-    )
+    let inv = inv_inertia(i) + j.map_or(0.0, inv_inertia);
+    let m = rolling_torque(s.rolling.mu_r, spin, r_roll, f_n, inv, s.dt);
+    (m, 0.0)
 }

@@ -153,6 +153,8 @@ pub(super) fn spheropolygon_candidate(
         f_t: f.force[0] * t[0] + f.force[1] * t[1],
         overlap: deepest.delta,
         energy: f.contacts.iter().map(|(_, r)| r.energy).sum(),
+        // Rods take no rolling resistance (scene::validate).
+        rolling: 0.0,
     };
     (Some(c), f.springs)
 }
