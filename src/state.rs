@@ -34,6 +34,9 @@ pub struct Particles {
     /// The copy of the scene a particle belongs to (`replicas`; 0 without copies): it
     /// touches only particles of its own copy.
     pub copy: Vec<u32>,
+    /// The domain's period in x (scene `domain.periodic_x`), 0 when not periodic: the
+    /// positions are then taken modulo it (`offset`). Set from the scene with the state.
+    pub period_x: f64,
 }
 
 /// A new particle before it joins the state.
@@ -198,6 +201,7 @@ impl Particles {
             shape: index.iter().map(|&i| self.shape[i].clone()).collect(),
             sweep: pick(&self.sweep),
             copy: Vec::new(),
+            period_x: self.period_x,
         };
         p.copy = vec![0; index.len()];
         (p, index)
@@ -209,11 +213,25 @@ impl Particles {
 }
 
 /// r_i − r_j: the offset of the pair, the only way positions enter a contact's geometry
-/// (issue 18).
+/// (issue 18); in a domain periodic in x, to j's nearest image.
 #[inline]
 pub fn offset(particles: &Particles, i: usize, j: usize) -> [f64; 2] {
     let (pi, pj) = (particles.position(i), particles.position(j));
-    [pi[0] - pj[0], pi[1] - pj[1]]
+    [
+        nearest_image(pi[0] - pj[0], particles.period_x),
+        pi[1] - pj[1],
+    ]
+}
+
+/// A difference of x coordinates to its nearest image under the period `period` (0: not
+/// periodic, `dx` as it is).
+#[inline(always)]
+pub fn nearest_image(dx: f64, period: f64) -> f64 {
+    if period > 0.0 {
+        dx - period * (dx / period).round()
+    } else {
+        dx
+    }
 }
 
 /// `v` in a new order: `out[k] = v[from[k]]`.

@@ -69,6 +69,7 @@ fn column(units: &str) -> Analysis {
         log: None,
         length_unit: length.into(),
         force_unit: force.into(),
+        period_x: 0.0,
     };
     analyze::analyze(input, &Options::default()).unwrap()
 }

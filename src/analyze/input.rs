@@ -88,6 +88,8 @@ pub struct Input {
     /// Unit names of length, force, time (for CSV headers).
     pub length_unit: String,
     pub force_unit: String,
+    /// The domain's period in x (scene `domain.periodic_x`), 0 when not periodic.
+    pub period_x: f64,
 }
 
 /// The snapshot a path names: a snapshot's .json, or a run folder (its final.json).
@@ -284,6 +286,9 @@ pub fn of_snapshot(
     let units = s.meta.units.clone();
     let default_g = if units == "si" { 9.81 } else { 1.0 };
     let mu = scene.and_then(|v| v.pointer("/contact/mu").and_then(|m| m.as_f64()));
+    let period_x = scene
+        .and_then(|v| serde_json::from_value::<crate::scene::Domain>(v.get("domain")?.clone()).ok())
+        .map_or(0.0, |d| d.period_x());
     let (length_unit, force_unit) = if units == "si" {
         ("m", "N")
     } else {
@@ -302,5 +307,6 @@ pub fn of_snapshot(
         log: None,
         length_unit: length_unit.into(),
         force_unit: force_unit.into(),
+        period_x,
     })
 }

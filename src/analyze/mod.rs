@@ -211,7 +211,7 @@ pub fn analyze_series(
     let mut from = a.summary.time;
     for e in &earlier {
         from = from.min(e.time);
-        let m = stress::moments(&e.grains, &e.touches);
+        let m = stress::moments(&e.grains, &e.touches, e.period_x);
         let w =
             stress::moving_averages(&e.grains, &m, &o, opt.row * d, opt.window * d, opt.step * d);
         let p = heap::wall_pressure(&e.grains, &e.touches, &o, opt.window * d, opt.step * d);
@@ -256,7 +256,7 @@ pub fn analyze(input: Input, opt: &Options) -> Result<Analysis, AnalyzeError> {
     let density = total_mass / total_area;
     let o = outline::trimmed(grains, d);
     let scale = 0.5 * density * input.g * o.height;
-    let moments = stress::moments(grains, &input.touches);
+    let moments = stress::moments(grains, &input.touches, input.period_x);
     let windows = stress::moving_averages(
         grains,
         &moments,

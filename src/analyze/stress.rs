@@ -53,11 +53,16 @@ impl Tensor {
 }
 
 /// Σ_c f ⊗ l of each grain (not divided by any volume), compression positive.
-pub fn moments(grains: &[Grain], touches: &[Touch]) -> Vec<Tensor> {
+/// `period_x`: the domain's period in x (0: none), across which a contact point lies
+/// by one grain and its image by the other.
+pub fn moments(grains: &[Grain], touches: &[Touch], period_x: f64) -> Vec<Tensor> {
     let mut m = vec![Tensor::default(); grains.len()];
     let mut add = |k: usize, f: [f64; 2], sign: f64, p: [f64; 2]| {
         let g = &grains[k];
-        let l = [p[0] - g.x, p[1] - g.z];
+        let l = [
+            crate::state::nearest_image(p[0] - g.x, period_x),
+            p[1] - g.z,
+        ];
         m[k].add(Tensor {
             xx: -sign * f[0] * l[0],
             xz: -sign * f[0] * l[1],

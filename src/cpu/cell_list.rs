@@ -34,6 +34,21 @@ impl Grid {
         }
     }
 
+    /// A grid for a domain periodic in x: `nx` cells of at least `min_cell` fill the
+    /// period exactly (cells across the seam are neighbours), square, as many rows as
+    /// fit in z (the last row takes what lies beyond, as `cell_coords` clamps).
+    pub fn periodic(x: [f64; 2], z: [f64; 2], min_cell: f64) -> Self {
+        let nx = (((x[1] - x[0]) / min_cell).floor() as u32).max(1);
+        let cell_size = (x[1] - x[0]) / nx as f64;
+        let nz = (((z[1] - z[0]) / cell_size).floor() as u32).max(1);
+        Self {
+            origin: [x[0], z[0]],
+            cell_size,
+            nx,
+            nz,
+        }
+    }
+
     /// This grid with its cells doubled until they are at least `min_cell` wide (the
     /// same origin; the last cells may reach beyond the domain): the GPU path's grid for
     /// the neighbour lists. Its fixed-point unit is the old one times a power of two, so

@@ -110,10 +110,11 @@ impl NeighbourList {
     }
 
     /// The grid of a rebuild for candidates within `reach`: the last one while its
-    /// cells are wide enough.
-    pub fn grid_for(&self, domain: ([f64; 2], [f64; 2]), reach: f64) -> Grid {
+    /// cells are wide enough. `period`: the domain's period in x (0: none).
+    pub fn grid_for(&self, domain: ([f64; 2], [f64; 2]), reach: f64, period: f64) -> Grid {
         match &self.grid {
             Some(g) if g.cell_size >= reach => g.clone(),
+            _ if period > 0.0 => Grid::periodic(domain.0, domain.1, reach),
             _ => Grid::new(domain.0, domain.1, reach),
         }
     }
@@ -134,7 +135,7 @@ impl NeighbourList {
         table: &SpringTable,
     ) {
         let reach = range_factor * max_diameter + skin;
-        let grid = self.grid_for(domain, reach);
+        let grid = self.grid_for(domain, reach, particles.period_x);
         sort_by_cell(&grid, particles, ids, &mut self.cells);
         let mut pairs = Vec::with_capacity(self.pairs.len().max(4 * particles.len()));
         let mut start = Vec::with_capacity(particles.len() + 1);
@@ -425,15 +426,28 @@ fn candidates_of(s: &Search, i: usize, out: &mut Vec<Pair>) {
     let pi = [pos[i][0], pos[i][1]];
     let (cx, cz) = grid.cell_coords(pi);
     let (x0, x1) = (cx.saturating_sub(1), (cx + 1).min(grid.nx - 1));
+    // Across the seam of a periodic domain (at least three cells wide, validated): the
+    // column at the other end, a run of its own.
+    let period = particles.period_x;
+    let seam = match (period > 0.0, cx) {
+        (true, 0) => Some(grid.nx - 1),
+        (true, c) if c == grid.nx - 1 => Some(0),
+        _ => None,
+    };
     let mut found: Vec<(u32, u32)> = Vec::new();
     for z in cz.saturating_sub(1)..=(cz + 1).min(grid.nz - 1) {
         // The three cells x0..=x1 of a row are one run of the sorted list.
-        for &(_, id, j) in row_of_cells(grid, s.cells, particles.copy[i], [x0, x1], z) {
+        let near = row_of_cells(grid, s.cells, particles.copy[i], [x0, x1], z);
+        let across = seam.map_or(&[][..], |c| {
+            row_of_cells(grid, s.cells, particles.copy[i], [c, c], z)
+        });
+        for &(_, id, j) in near.iter().chain(across) {
             let ju = j as usize;
             if id <= s.ids[i] || (particles.fixed[i] && particles.fixed[ju]) {
                 continue;
             }
-            let (dx, dz) = (pos[ju][0] - pi[0], pos[ju][1] - pi[1]);
+            let dx = crate::state::nearest_image(pos[ju][0] - pi[0], period);
+            let dz = pos[ju][1] - pi[1];
             let reach = s.range_factor * (particles.radius[i] + particles.radius[ju]) + skin;
             // A NaN distance (a diverged state) is no candidate.
             if dx * dx + dz * dz < reach * reach {

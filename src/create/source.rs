@@ -258,7 +258,8 @@ fn is_free(particles: &Particles, p: [f64; 2], r: f64, copy: u32) -> bool {
             return true;
         }
         let q = particles.position(j);
-        let (dx, dz) = (p[0] - q[0], p[1] - q[1]);
+        let dx = crate::state::nearest_image(p[0] - q[0], particles.period_x);
+        let dz = p[1] - q[1];
         let s = r + particles.radius[j];
         dx * dx + dz * dz >= s * s
     })
@@ -284,7 +285,8 @@ pub fn emit(
         let pos = new.position;
         // The spot is free when the circumscribed circles do not touch.
         let fresh_ok = out.iter().all(|o: &NewParticle| {
-            let (dx, dz) = (o.position[0] - pos[0], o.position[1] - pos[1]);
+            let dx = crate::state::nearest_image(o.position[0] - pos[0], particles.period_x);
+            let dz = o.position[1] - pos[1];
             dx * dx + dz * dz >= (o.radius + new.radius).powi(2)
         });
         if !(fresh_ok && is_free(particles, pos, new.radius, copy)) {

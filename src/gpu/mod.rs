@@ -199,6 +199,12 @@ pub fn unsupported(sim: &Simulation) -> Option<String> {
     if let Some(reason) = unsupported_spheropolygons(sim) {
         return Some(reason);
     }
+    if sim.scene.domain.periodic_x {
+        return Some(
+            "a domain periodic in x (domain.periodic_x) is not on the GPU path yet; the CPU path takes it"
+                .into(),
+        );
+    }
     // Props.flags holds material and copy in 12 bits each.
     let field = 1usize << (layout::COPY_SHIFT - layout::MATERIAL_SHIFT);
     if sim.scene.materials.len() > field || sim.scene.replicas as usize > field {

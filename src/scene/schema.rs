@@ -120,12 +120,29 @@ pub struct Gravity {
     pub ramp_time: f64,
 }
 
-/// The simulation box. Particles whose centre leaves it are removed and counted as lost.
+/// The simulation box. Particles whose centre leaves it are removed and counted as lost,
+/// except across x under `periodic_x`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Domain {
     pub x: [f64; 2],
     pub z: [f64; 2],
+    /// Periodic in x (LAMMPS `boundary p`): a particle leaving through one side comes
+    /// back through the other, and particles touch across the seam (the nearest image).
+    /// CPU path only so far.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub periodic_x: bool,
+}
+
+impl Domain {
+    /// The period in x, 0 when not periodic.
+    pub fn period_x(&self) -> f64 {
+        if self.periodic_x {
+            self.x[1] - self.x[0]
+        } else {
+            0.0
+        }
+    }
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]

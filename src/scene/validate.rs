@@ -426,8 +426,34 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
     let law = ContactLaw::of_scene(scene)?;
     spheropolygons(scene, &law)?;
     rolling(scene, &law)?;
+    periodic(scene, &law)?;
     warnings.extend(super::stability::time_step(scene, &law)?);
     Ok(Checked { law, warnings })
+}
+
+/// A domain periodic in x is at least three neighbour-search cells wide (range and
+/// skin of its largest particle), so that a particle sees a neighbour at most once,
+/// through the nearest image (`state::offset`).
+fn periodic(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
+    if !scene.domain.periodic_x {
+        return Ok(());
+    }
+    let d = super::sizes::max_diameter(scene);
+    let skin = scene
+        .skin
+        .unwrap_or(crate::cpu::neighbours::DEFAULT_SKIN * d);
+    let reach = law.range_factor() * d + skin;
+    let width = scene.domain.x[1] - scene.domain.x[0];
+    if width < 3.0 * reach {
+        return Err(SceneError::invalid(
+            "domain.x",
+            format!(
+                "a domain periodic in x must be at least 3 neighbour cells wide, 3 × (range × largest diameter + skin) = {:.4e}; it is {width:.4e}",
+                3.0 * reach
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Rolling resistance (src/law/rolling.rs) acts at disk contacts: under the disk laws,

@@ -89,13 +89,16 @@ impl Simulation {
         }
     }
 
-    /// Boundary stage: particles whose centre left the domain are removed.
+    /// Boundary stage: particles whose centre left the domain are removed (across a
+    /// periodic x, brought back through the other side).
     pub(super) fn remove_escaped(&mut self) {
         let d = &self.scene.domain;
+        let period = d.period_x();
         for i in 0..self.particles.len() {
             if !self.particles.active[i] {
                 continue;
             }
+            super::start::wrap(d.x, period, &mut self.particles.q[0][i]);
             if outside(d.x, d.z, self.particles.q[0][i]) {
                 self.particles.active[i] = false;
                 self.lost += 1;

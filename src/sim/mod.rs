@@ -30,7 +30,7 @@ pub use insert::{copy_seed, creators};
 
 use divergence::SurveyWatch;
 use insert::source_count;
-use start::{check_created, outside};
+use start::{check_created, outside, wrap};
 
 /// The shortest `Simulation::advance` that sorts the particles in memory: sorting and
 /// putting back cost a few steps' time (measured: 1–3 steps at 10⁵ disks).
@@ -140,6 +140,8 @@ impl Simulation {
         lost: u64,
     ) -> Result<Self, SceneError> {
         let law = ContactLaw::of_scene(&scene)?;
+        let mut particles = particles;
+        particles.period_x = scene.domain.period_x();
         let copies = scene.replicas as usize;
         if sources.len() != copies * source_count(&scene) {
             return Err(SceneError::invalid(
@@ -276,7 +278,7 @@ impl Simulation {
     /// write of the Gear values instead of two. Returns the survey's answer.
     fn correct_ahead(&mut self, gravity: [f64; 2]) -> bool {
         let (dt, d) = (self.scene.dt, &self.scene.domain);
-        let (x, z) = (d.x, d.z);
+        let (x, z, period) = (d.x, d.z, d.period_x());
         let escaped = AtomicUsize::new(0);
         let (list, kicks) = (&self.neighbours, &self.candidates.kicks);
         let watch = SurveyWatch::new(list, &self.ids, &self.particles, &self.scene);
@@ -304,6 +306,9 @@ impl Simulation {
                         gravity,
                     );
                     gear::correct_in_place([&mut *q0, &mut *q1, q2, q3, q4, q5], a, dt);
+                }
+                if *on {
+                    wrap(x, period, q0);
                 }
                 if *on && outside(x, z, *q0) {
                     *on = false;
@@ -338,7 +343,9 @@ impl Simulation {
             let domain = (d.x, d.z);
             if self.reorder {
                 let reach = self.law.range_factor() * self.largest_diameter() + self.skin();
-                let grid = self.neighbours.grid_for(domain, reach);
+                let grid = self
+                    .neighbours
+                    .grid_for(domain, reach, self.particles.period_x);
                 let order = cell_order(&grid, &self.particles, &self.ids);
                 if order
                     .iter()

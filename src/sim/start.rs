@@ -160,6 +160,19 @@ pub(super) fn check_created(
     Ok(())
 }
 
+/// A position that left a domain periodic in x (`period` > 0) through one side, brought
+/// back through the other.
+#[inline(always)]
+pub(super) fn wrap(x: [f64; 2], period: f64, p: &mut Dof) {
+    if period > 0.0 {
+        if p[0] < x[0] {
+            p[0] += period;
+        } else if p[0] >= x[1] {
+            p[0] -= period;
+        }
+    }
+}
+
 /// Whether a position lies outside the domain [x0, x1] × [z0, z1] (a NaN does not).
 #[inline(always)]
 pub(super) fn outside(x: [f64; 2], z: [f64; 2], p: Dof) -> bool {
