@@ -10,7 +10,10 @@ fn leave_domain(i: u32, s: State) {
     let p = position(s);
     let ok = abs(s.q[0].x) <= 3.0e38 && abs(s.q[0].y) <= 3.0e38 && abs(s.q[0].z) <= 3.0e38;
     if (!ok) { halt(HALT_NOT_FINITE, i); return; }
-    if (p.x < params.dom_lo_x || p.x > params.dom_hi_x || p.y < params.dom_lo_z || p.y > params.dom_hi_z) {
+    // Across a periodic x the centre has come back through the other side (its anchor
+    // wrapped in `renormalize`): only z can be left.
+    let left_x = params.period_cells == 0u && (p.x < params.dom_lo_x || p.x > params.dom_hi_x);
+    if (left_x || p.y < params.dom_lo_z || p.y > params.dom_hi_z) {
         props[i].flags &= ~ACTIVE;
         atomicAdd(&control[C_LOST], 1u);
         // Its candidates leave the lists at the next step (as on the CPU path).

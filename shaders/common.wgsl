@@ -154,7 +154,9 @@ struct Params {
     rolling_mu: f32,
     rolling_k: f32,
     rolling_eta: f32,
-    pad_roll0: u32,
+    // a domain periodic in x: its period in whole cells (src/gpu/mod.rs `device_grid`), 0
+    // when not periodic
+    period_cells: u32,
     pad_roll1: u32,
     pad_roll2: u32,
     pair_law: array<vec4<f32>, 2u * MAX_PAIR_SLOTS>,

@@ -45,12 +45,18 @@ fn find_contacts(@builtin(global_invocation_id) gid: vec3<u32>) {
     let c = cell_coords(state[i].anchor);
     let z0 = max(i32(c.y) - 1, 0);
     let z1 = min(c.y + 1u, params.nz - 1u);
-    let x0 = max(i32(c.x) - 1, 0);
-    let x1 = min(c.x + 1u, params.nx - 1u);
+    var x0 = max(i32(c.x) - 1, 0);
+    var x1 = i32(min(c.x + 1u, params.nx - 1u));
+    // Periodic in x (at least three columns, validated): the columns on either side,
+    // across the seam too.
+    let periodic = params.period_cells > 0u;
+    if (periodic) { x0 = i32(c.x) - 1; x1 = i32(c.x) + 1; }
     let hashed = hashed_grid();
     var full = false;
     for (var z = u32(z0); z <= z1 && !full; z++) {
-        for (var x = u32(x0); x <= x1 && !full; x++) {
+        for (var xs = x0; xs <= x1 && !full; xs++) {
+            var x = u32(xs);
+            if (periodic) { x = u32((xs + i32(params.nx)) % i32(params.nx)); }
             let cell = bucket(vec2<u32>(x, z));
             let start = cell_start[cell];
             let end = start + atomicLoad(&cell_count[cell]);

@@ -7,7 +7,8 @@
 fn touches(c: Candidate, p: u32) -> bool {
     // Only the particles of the candidate's own copy of the scene are in its way.
     if (copy_of(c.flags) != copy_of(props[p].flags)) { return false; }
-    let o = offset(c.anchor, c.frac, c.rem, state[p].anchor, state[p].frac, state[p].q[0].xy);
+    let o = offset(c.anchor, c.frac, c.rem, image_anchor(c.anchor, state[p].anchor),
+                   state[p].frac, state[p].q[0].xy);
     if (!o.near) { return false; }
     let d = offset_vector(o);
     let s = c.radius + props[p].radius;

@@ -38,8 +38,31 @@ fn offset(ai: vec2<i32>, fi: vec2<u32>, ri: vec2<f32>,
 
 fn offset_ij(i: u32, j: u32) -> Offset {
     // Only the position's fields (a copy of the whole State would load 128 bytes each).
-    return offset(state[i].anchor, state[i].frac, state[i].q[0].xy,
-                  state[j].anchor, state[j].frac, state[j].q[0].xy);
+    let ai = state[i].anchor;
+    return offset(ai, state[i].frac, state[i].q[0].xy,
+                  image_anchor(ai, state[j].anchor), state[j].frac, state[j].q[0].xy);
+}
+
+// In a domain periodic in x (params.period_cells > 0), the anchor of the image of aj
+// nearest to ai (src/state.rs `nearest_image`): shifted by the period in whole cells,
+// so that the offset stays exact. Between two particles only, never to a wall's end.
+fn image_anchor(ai: vec2<i32>, aj: vec2<i32>) -> vec2<i32> {
+    if (params.period_cells == 0u) { return aj; }
+    let p = i32(params.period_cells);
+    let dx = ai.x - aj.x;
+    var a = aj;
+    if (dx > p / 2) { a.x += p; } else if (dx < -(p / 2)) { a.x -= p; }
+    return a;
+}
+
+// An anchor's cell column brought into [0, period) (src/sim/start.rs `wrap`): a centre
+// that left through one side comes back through the other, by whole cells (exact).
+fn wrap_anchor(a: vec2<i32>) -> vec2<i32> {
+    if (params.period_cells == 0u) { return a; }
+    let p = i32(params.period_cells);
+    var w = a;
+    if (w.x < 0) { w.x += p; } else if (w.x >= p) { w.x -= p; }
+    return w;
 }
 
 // The offset as an f32 vector in length units, to f32's relative precision of its
@@ -121,7 +144,7 @@ fn renormalize(s: ptr<function, State>) {
     let x = renormalize_axis((*s).q[0].x, (*s).anchor.x, (*s).frac.x);
     let z = renormalize_axis((*s).q[0].y, (*s).anchor.y, (*s).frac.y);
     (*s).q[0] = vec4<f32>(x.rem, z.rem, (*s).q[0].zw);
-    (*s).anchor = vec2<i32>(x.anchor, z.anchor);
+    (*s).anchor = wrap_anchor(vec2<i32>(x.anchor, z.anchor));
     (*s).frac = vec2<u32>(x.frac, z.frac);
 }
 
@@ -174,7 +197,7 @@ fn renormalize_q1(s: ptr<function, State>) {
 // them through `displace` and `turn_by`).
 fn move_by_whole_q1(s: ptr<function, State>) {
     let f = vec2<i32>((*s).frac) + (*s).q1_whole.xy;
-    (*s).anchor += f >> vec2<u32>(30u);
+    (*s).anchor = wrap_anchor((*s).anchor + (f >> vec2<u32>(30u)));
     (*s).frac = vec2<u32>(f & vec2<i32>(FRAC_MASK));
     (*s).turn += bitcast<u32>((*s).q1_whole.z);
 }

@@ -40,6 +40,15 @@ pub(super) fn cmd_check(
     for line in lines {
         out!("{line}");
     }
+    let d = &sim.scene.domain;
+    if d.periodic_x {
+        out!(
+            "domain periodic in x (domain.periodic_x): period {} from x = {} to {}; particles leave through one side and come back through the other, and touch across the seam",
+            d.period_x(),
+            d.x[0],
+            d.x[1]
+        );
+    }
     for (k, v) in sim.wall_velocity.iter().enumerate() {
         if v[0] != 0.0 || v[1] != 0.0 {
             out!(

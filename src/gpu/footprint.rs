@@ -107,7 +107,7 @@ pub fn footprint(sim: &Simulation) -> Footprint {
         .saturating_add(to_come)
         .saturating_add(layered)
         .max(1);
-    let grid = sim.grid.coarsened(sim.grid.cell_size + sim.skin());
+    let grid = super::device_grid(sim);
     let cells = bucket_count(&grid, n.min(u32::MAX as u64) as u32);
     let swept = super::keeps_sub_springs(sim);
     Footprint {

@@ -152,7 +152,9 @@ pub struct Params {
     pub rolling_mu: f32,
     pub rolling_k: f32,
     pub rolling_eta: f32,
-    pub pad_roll0: u32,
+    /// A domain periodic in x (scene `domain.periodic_x`): its period in whole cells of
+    /// the grid, whose columns fill it exactly (`gpu::device_grid`); 0 when not periodic.
+    pub period_cells: u32,
     pub pad_roll1: u32,
     pub pad_roll2: u32,
     /// Slot s = a · pair_side + b of materials a and b (b = pair_side − 1: a wall):
@@ -364,7 +366,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 rolling_mu,
                 rolling_k,
                 rolling_eta,
-                pad_roll0,
+                period_cells,
                 pad_roll1,
                 pad_roll2,
                 pair_law

@@ -199,12 +199,6 @@ pub fn unsupported(sim: &Simulation) -> Option<String> {
     if let Some(reason) = unsupported_spheropolygons(sim) {
         return Some(reason);
     }
-    if sim.scene.domain.periodic_x {
-        return Some(
-            "a domain periodic in x (domain.periodic_x) is not on the GPU path yet; the CPU path takes it"
-                .into(),
-        );
-    }
     // Props.flags holds material and copy in 12 bits each.
     let field = 1usize << (layout::COPY_SHIFT - layout::MATERIAL_SHIFT);
     if sim.scene.materials.len() > field || sim.scene.replicas as usize > field {
@@ -259,6 +253,22 @@ fn unsupported_spheropolygons(sim: &Simulation) -> Option<String> {
     })
 }
 
+/// The grid of the device's cell list and fixed-point positions: the law's grid with
+/// its cells doubled until they hold range + skin (the fixed-point unit scales by a
+/// power of two, which keeps lattice piles exactly aligned); in a domain periodic in x,
+/// cells of at least range + skin whose columns fill the period exactly, so that a
+/// centre crossing the seam moves by whole cells (`Params::period_cells`).
+pub(crate) fn device_grid(sim: &Simulation) -> crate::cpu::cell_list::Grid {
+    let skin = sim.skin();
+    let d = &sim.scene.domain;
+    if d.periodic_x {
+        let max_d = crate::scene::max_diameter(&sim.scene).max(2.0 * sim.particles.max_radius());
+        let reach = sim.law.range_factor() * max_d + skin;
+        return crate::cpu::cell_list::Grid::periodic(d.x, d.z, reach);
+    }
+    sim.grid.coarsened(sim.grid.cell_size + skin)
+}
+
 /// Whether the scene keeps `SubSprings` per candidate slot and table entry (`sub_hist`,
 /// `table_sub`): spheropolygons' sub-contact springs, or disk pairs' rolling springs
 /// (rolling model `spring_dashpot`). WGSL twin: `sub_springs_kept` in common.wgsl.
@@ -309,12 +319,10 @@ impl GpuSimulation {
             return Err(GpuError::Unsupported(reason));
         }
         let (_, layered_specs) = crate::sim::creators(&sim.scene);
-        // Cells hold every candidate within range + skin of the lists (issue 13): the
-        // law's grid with its cells doubled (the fixed-point unit scales by a power of
-        // two; any other size loses the lattice piles' exact alignment, see
-        // tests/gpu_scenes.rs `lattice_pile_agrees_with_the_cpu`).
+        // Cells hold every candidate within range + skin of the lists (issue 13; see
+        // `device_grid`, and tests/gpu_scenes.rs `lattice_pile_agrees_with_the_cpu`).
         let skin = sim.skin();
-        let grid = sim.grid.coarsened(sim.grid.cell_size + skin);
+        let grid = device_grid(&sim);
         // Every particle the point sources will still insert is drawn below, on the
         // host, and every buffer is sized for them: check that they and the grid fit the
         // adapter first (a count of 4·10⁹ would otherwise abort on allocation; issue 16).

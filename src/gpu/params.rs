@@ -217,6 +217,11 @@ pub(super) fn step_params(
             0.0
         },
         rolling_eta: sim.rolling.eta_r as f32,
+        period_cells: if sim.scene.domain.periodic_x {
+            grid.nx
+        } else {
+            0
+        },
         ..Default::default()
     };
     law_params(law, &mut params);

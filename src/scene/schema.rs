@@ -129,7 +129,7 @@ pub struct Domain {
     pub z: [f64; 2],
     /// Periodic in x (LAMMPS `boundary p`): a particle leaving through one side comes
     /// back through the other, and particles touch across the seam (the nearest image).
-    /// CPU path only so far.
+    /// Both paths.
     #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub periodic_x: bool,
 }
