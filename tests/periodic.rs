@@ -327,3 +327,47 @@ fn talus_check_names_a_periodic_domain() {
     ]);
     assert!(!out.contains("periodic"), "{out}");
 }
+
+#[test]
+fn outputs_draw_contacts_across_the_seam_to_the_nearest_image() {
+    // The layer at rest on a still floor through `talus run`: its rows settle onto each
+    // other, across the seam too (the odd rows' last grain sits at x = L ≡ 0); every
+    // contact line in contacts.vtp joins a grain to its partner's image beside it
+    // (shorter than two diameters), none spans the domain; the pictures are drawn.
+    let dir = tmp("periodic", "outputs");
+    let scene = dir.join("layer.json");
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut v = dragged_layer(0.0);
+    v["stop"] = json!({ "time": 3.0 });
+    v["output"] = json!({ "checkpoint_every": 0 });
+    std::fs::write(&scene, v.to_string()).unwrap();
+    let out = dir.join("run");
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    talus_ok([
+        "run",
+        "-q",
+        "--backend",
+        "cpu",
+        &s(&scene),
+        "--out",
+        &s(&out),
+    ]);
+    let vtp = common::vtp::read(&out.join("pictures").join("contacts.vtp"));
+    let points = vtp.get("Points", "Points");
+    let lines = points.len() / 6;
+    let longest = (0..lines)
+        .map(|k| {
+            let (a, b) = (&points[6 * k..6 * k + 3], &points[6 * k + 3..6 * k + 6]);
+            (a[0] - b[0]).hypot(a[1] - b[1])
+        })
+        .fold(0.0, f64::max);
+    eprintln!("{lines} contact lines, the longest {longest}");
+    assert!(lines > 100, "{lines} contacts");
+    assert!(
+        longest < 2.0,
+        "a contact line of {longest} spans the domain"
+    );
+    for f in ["grains.png", "forces.png", "stress_crosses.png"] {
+        assert!(out.join("pictures").join(f).is_file(), "{f}");
+    }
+}

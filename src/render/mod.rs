@@ -339,6 +339,35 @@ impl Canvas {
         }
     }
 
+    /// `shape` of a grain and, in a domain periodic in x (`period` > 0), of its images
+    /// one period to either side where they reach into the view (a grain astride the
+    /// seam shows on both sides).
+    fn shapes(
+        &mut self,
+        g: &crate::analyze::input::Grain,
+        period: f64,
+        fill: [u8; 3],
+        stroke: Option<[u8; 3]>,
+        width: f32,
+    ) {
+        self.shape(g, fill, stroke, width);
+        if period <= 0.0 {
+            return;
+        }
+        let (lo, hi) = (
+            self.view.left,
+            self.view.left + self.view.width as f64 / self.view.scale,
+        );
+        for shift in [-period, period] {
+            if g.right() + shift > lo && g.left() + shift < hi {
+                let mut image = g.clone();
+                image.x += shift;
+                image.corners.iter_mut().for_each(|c| c[0] += shift);
+                self.shape(&image, fill, stroke, width);
+            }
+        }
+    }
+
     fn line(&mut self, a: (f64, f64), b: (f64, f64), width: f32, color: [u8; 3]) {
         let v = self.view;
         let (p, q) = (v.p(a.0, a.1), v.p(b.0, b.1));
@@ -448,6 +477,8 @@ pub fn render_marked(
     let mut files = Vec::new();
     let view = View::of(a, width);
     let line = (0.04 * a.summary.mean_diameter * view.scale).clamp(0.3, 2.0) as f32;
+    // A domain periodic in x: grains astride the seam drawn on both sides.
+    let period = a.input.period_x;
     // Grains coloured by the field.
     let (values, scale) = field_values(a, field);
     let map = scale.as_ref().map_or(Map::Sequential, |s| s.map);
@@ -460,7 +491,7 @@ pub fn render_marked(
         } else {
             GREY
         };
-        c.shape(g, fill, Some(INK), 0.5 * line);
+        c.shapes(g, period, fill, Some(INK), 0.5 * line);
     }
     legend::length_scale(&mut c, &a.input.length_unit);
     legend::caption(&mut c, &a.input);
@@ -472,7 +503,7 @@ pub fn render_marked(
     // contact point for a wall), its width proportional to the normal force.
     let mut c = Canvas::new(view)?;
     for g in &a.input.grains {
-        c.shape(g, [235, 235, 235], Some(GREY), 0.5 * line);
+        c.shapes(g, period, [235, 235, 235], Some(GREY), 0.5 * line);
     }
     let fmax = a
         .input
@@ -488,7 +519,14 @@ pub fn render_marked(
             }
             let ga = &a.input.grains[t.a];
             let end = match t.b {
-                Some(b) => (a.input.grains[b].x, a.input.grains[b].z),
+                // Across a periodic seam, to the partner's image beside ga.
+                Some(b) => {
+                    let gb = &a.input.grains[b];
+                    (
+                        ga.x + crate::state::nearest_image(gb.x - ga.x, period),
+                        gb.z,
+                    )
+                }
                 None => (t.point[0], t.point[1]),
             };
             c.line(
@@ -509,7 +547,13 @@ pub fn render_marked(
     // and σ_min, blue for compression and red for tension.
     let mut c = Canvas::new(view)?;
     for g in &a.input.grains {
-        c.shape(g, [240, 240, 240], Some([225, 225, 225]), 0.5 * line);
+        c.shapes(
+            g,
+            period,
+            [240, 240, 240],
+            Some([225, 225, 225]),
+            0.5 * line,
+        );
     }
     let windows: Vec<&crate::analyze::stress::Window> =
         a.windows.iter().filter(|w| w.particles > 0).collect();
@@ -576,7 +620,7 @@ fn repose_lines(
         } else {
             [235, 235, 235]
         };
-        c.shape(g, fill, Some(GREY), 0.5 * line);
+        c.shapes(g, a.input.period_x, fill, Some(GREY), 0.5 * line);
     }
     let s = &a.summary;
     let r = &s.repose_readings;

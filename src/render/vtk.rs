@@ -282,7 +282,11 @@ pub fn write_named(a: &Analysis, dir: &Path, prefix: &str) -> Result<Vec<PathBuf
     for t in &a.input.touches {
         let ga = &grains[t.a];
         let end = match t.b {
-            Some(b) => [grains[b].x, grains[b].z],
+            // Across a periodic seam, to the partner's image beside ga.
+            Some(b) => [
+                ga.x + crate::state::nearest_image(grains[b].x - ga.x, a.input.period_x),
+                grains[b].z,
+            ],
             None => t.point,
         };
         piece
