@@ -36,8 +36,7 @@ use crate::overlap::Hint;
 use crate::state::{Dof, Particles, gather};
 use std::sync::atomic::{AtomicU32, Ordering};
 
-/// The default skin, as a fraction of the largest diameter.
-pub const DEFAULT_SKIN: f64 = 0.3;
+pub use crate::scene::DEFAULT_SKIN;
 
 #[derive(Clone, Debug, Default)]
 pub struct NeighbourList {

@@ -120,6 +120,10 @@ pub struct Gravity {
     pub ramp_time: f64,
 }
 
+/// The neighbour lists' skin when the scene gives none (`skin`), as a fraction of the
+/// largest diameter.
+pub const DEFAULT_SKIN: f64 = 0.3;
+
 /// The simulation box. Particles whose centre leaves it are removed and counted as lost,
 /// except across x under `periodic_x`.
 #[derive(Clone, Debug, Serialize, Deserialize)]

@@ -439,9 +439,7 @@ fn periodic(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
         return Ok(());
     }
     let d = super::sizes::max_diameter(scene);
-    let skin = scene
-        .skin
-        .unwrap_or(crate::cpu::neighbours::DEFAULT_SKIN * d);
+    let skin = scene.skin.unwrap_or(super::DEFAULT_SKIN * d);
     let reach = law.range_factor() * d + skin;
     let width = scene.domain.x[1] - scene.domain.x[0];
     if width < 3.0 * reach {
