@@ -141,19 +141,22 @@ struct Params {
     max_step2: f32,
     // The spring-dashpot law's coefficients per pair of materials (src/law/restitution.rs,
     // src/gpu/layout.rs): slot s = a pair_side + b (b = pair_side - 1: a wall) has
-    // pair_law[2s] = (k_n, gamma_n, k_t, gamma_t) and pair_law[2s + 1].x = mu, per unit
-    // of the contact's effective mass when per_mass is 1.
+    // pair_law[2s] = (k_n, gamma_n, k_t, gamma_t) and pair_law[2s + 1] = (mu, mu_r,
+    // k_roll, eta_r), the first four per unit of the contact's effective mass when
+    // per_mass is 1; the rolling resistance's table (src/law/rolling.rs RollingTable)
+    // shares the slots.
     pair_side: u32,
     per_mass: u32,
     // The continuous law's readings of paper 001 (src/law/continuous.rs `Reading`):
     // READING_SLIP_DAMPING | READING_CONTACT_ARM, 0 for the paper's text; its clamp
     // is `clamp`.
     reading: u32,
-    // rolling resistance at disk contacts (src/law/rolling.rs): mu_r, 0 for none; the
-    // spring model's k_roll (0: the constant torque) and eta_r
+    // rolling resistance at disk contacts (src/law/rolling.rs), whose values per pair
+    // ride in pair_law[2s + 1].yzw (`rolling_of`): here the largest mu_r of any pair (0:
+    // none) and the largest k_roll (0: the constant torque), which choose the branches
     rolling_mu: f32,
     rolling_k: f32,
-    rolling_eta: f32,
+    pad_roll0: u32,
     // a domain periodic in x: its period in whole cells (src/gpu/mod.rs `device_grid`), 0
     // when not periodic
     period_cells: u32,

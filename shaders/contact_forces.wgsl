@@ -96,13 +96,27 @@ fn rolling_torque(mu_r: f32, spin: f32, r_roll: f32, f_n: f32, inv_inertia_sum: 
     return -sign(spin) * min(full, near_rest);
 }
 
+// Twin of src/law/rolling.rs `Rolling`: one pair of materials' rolling resistance.
+struct Rolling {
+    mu_r: f32,
+    k_roll: f32,
+    eta_r: f32,
+};
+
+// Twin of src/law/rolling.rs `RollingTable::get`: the rolling resistance of the pair of
+// materials in slot `pair` of Params.pair_law (`pair_slot`), in its second vec4's yzw.
+fn rolling_of(pair: u32) -> Rolling {
+    let r = params.pair_law[2u * pair + 1u];
+    return Rolling(r.y, r.z, r.w);
+}
+
 // Twin of src/law/rolling.rs `rolling_spring`: the spring-dashpot rolling torque of Ai
 // et al. (2011) eq. 9-16 on i (x) and the rolling spring after the step (y).
-fn rolling_spring(spring: f32, spin: f32, r_roll: f32, f_n: f32, inv_rolling_inertia: f32,
-                  dt: f32) -> vec2<f32> {
+fn rolling_spring(r: Rolling, spring: f32, spin: f32, r_roll: f32, f_n: f32,
+                  inv_rolling_inertia: f32, dt: f32) -> vec2<f32> {
     if (!(inv_rolling_inertia > 0.0)) { return vec2<f32>(0.0); }
-    let k_r = params.rolling_k * r_roll * r_roll;
-    let limit = params.rolling_mu * r_roll * max(f_n, 0.0);
+    let k_r = r.k_roll * r_roll * r_roll;
+    let limit = r.mu_r * r_roll * max(f_n, 0.0);
     let m_k = spring - k_r * spin * dt;
     if (abs(m_k) >= limit) {
         // Full mobilisation: the spring slips at its limit, no damping.
@@ -110,7 +124,7 @@ fn rolling_spring(spring: f32, spin: f32, r_roll: f32, f_n: f32, inv_rolling_ine
         if (m_k != 0.0) { held = sign(m_k) * limit; }
         return vec2<f32>(held, held);
     }
-    let c_r = params.rolling_eta * 2.0 * sqrt(k_r / inv_rolling_inertia);
+    let c_r = r.eta_r * 2.0 * sqrt(k_r / inv_rolling_inertia);
     return vec2<f32>(m_k - c_r * spin, m_k);
 }
 
@@ -211,6 +225,7 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
     if (res.lever > 0.0) { torques = vec2<f32>(-res.lever * res.f_t); }
     if (!POLYGONS && params.rolling_mu > 0.0) {
         // src/cpu/forces/mod.rs `rolling`: on i, and its opposite on j.
+        let roll = rolling_of(pair_slot(i, j, wall));
         var spin = v1.z;
         var r_roll = ri;
         var inv_inertia = select(props[i].inv_inertia, 0.0, is_fixed(i));
@@ -228,12 +243,12 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
             let old = sub_hist[slot];
             var spring = 0.0;
             if (old.key.x == ROLLING_KEY) { spring = old.xi.x; }
-            let r = rolling_spring(spring, spin, r_roll, res.f_n, inv_rolling, params.dt);
+            let r = rolling_spring(roll, spring, spin, r_roll, res.f_n, inv_rolling, params.dt);
             m = r.x;
             sub_hist[slot] = SubSprings(vec4<u32>(ROLLING_KEY, EMPTY, EMPTY, EMPTY),
                                         vec4<f32>(r.y, 0.0, 0.0, 0.0));
         } else {
-            m = rolling_torque(params.rolling_mu, spin, r_roll, res.f_n, inv_inertia, params.dt);
+            m = rolling_torque(roll.mu_r, spin, r_roll, res.f_n, inv_inertia, params.dt);
         }
         torques += vec2<f32>(m, -m);
     }

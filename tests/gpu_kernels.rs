@@ -274,7 +274,7 @@ fn cpu_contact_forces(
         &host.walls,
         &host.wall_velocity,
         &host.law,
-        host.rolling,
+        &host.rolling,
         host.dt(),
         pairs,
         history,

@@ -58,19 +58,8 @@ pub(super) fn cmd_check(
             );
         }
     }
-    let r = sim.rolling;
-    if r.has_spring() {
-        out!(
-            "rolling resistance at disk contacts: a rolling spring k_roll R*² with a dashpot at η_r of critical, plastic at μ_r R* f_n (Ai et al. 2011 model C), μ_r = {}, k_roll = {:.4e}, η_r = {} (R* = R_i R_j/(R_i + R_j), R_i at a wall; src/law/rolling.rs)",
-            r.mu_r,
-            r.k_roll,
-            r.eta_r
-        );
-    } else if !r.is_none() {
-        out!(
-            "rolling resistance at disk contacts: constant torque μ_r R* f_n against the relative spin, μ_r = {} (R* = R_i R_j/(R_i + R_j), R_i at a wall; src/law/rolling.rs)",
-            r.mu_r
-        );
+    for line in sim.rolling.describe(&names) {
+        out!("{line}");
     }
     if backend == Some(Backend::Gpu) {
         check_gpu_fit(&sim)?;

@@ -147,18 +147,19 @@ pub struct Params {
     /// The continuous law's readings of paper 001 (src/law/continuous.rs `Reading`):
     /// `READING_SLIP_DAMPING` | `READING_CONTACT_ARM`, 0 for the paper's text.
     pub reading: u32,
-    /// Rolling resistance at disk contacts (src/law/rolling.rs): μ_r, 0 for none; the
-    /// spring model's k_roll (0: the constant torque) and η_r.
+    /// Rolling resistance at disk contacts (src/law/rolling.rs), whose values per pair
+    /// ride in `pair_law[2s + 1].yzw`: here the largest μ_r of any pair (0: none) and
+    /// the largest k_roll (0: the constant torque), which choose the kernels' branches.
     pub rolling_mu: f32,
     pub rolling_k: f32,
-    pub rolling_eta: f32,
+    pub pad_roll0: u32,
     /// A domain periodic in x (scene `domain.periodic_x`): its period in whole cells of
     /// the grid, whose columns fill it exactly (`gpu::device_grid`); 0 when not periodic.
     pub period_cells: u32,
     pub pad_roll1: u32,
     pub pad_roll2: u32,
     /// Slot s = a · pair_side + b of materials a and b (b = pair_side − 1: a wall):
-    /// `pair_law[2s]` = (k_n, γ_n, k_t, γ_t), `pair_law[2s + 1].x` = μ.
+    /// `pair_law[2s]` = (k_n, γ_n, k_t, γ_t), `pair_law[2s + 1]` = (μ, μ_r, k_roll, η_r).
     pub pair_law: [[f32; 4]; 2 * MAX_PAIR_SLOTS],
 }
 
@@ -365,7 +366,7 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
                 reading,
                 rolling_mu,
                 rolling_k,
-                rolling_eta,
+                pad_roll0,
                 period_cells,
                 pad_roll1,
                 pad_roll2,

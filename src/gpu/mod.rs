@@ -206,9 +206,11 @@ pub fn unsupported(sim: &Simulation) -> Option<String> {
             "the GPU path holds at most {field} materials and {field} copies of a scene"
         ));
     }
-    if params::gpu_pair_side(&sim.law).is_none() {
+    if params::gpu_pair_side(&sim.law).is_none()
+        || sim.rolling.side * sim.rolling.side > layout::MAX_PAIR_SLOTS
+    {
         return Some(format!(
-            "the GPU path holds contact.pairs for at most {} materials (and the walls); the scene has {}",
+            "the GPU path holds contact.pairs and rolling.pairs for at most {} materials (and the walls); the scene has {}",
             layout::MAX_PAIR_SLOTS.isqrt() - 1,
             sim.scene.materials.len()
         ));

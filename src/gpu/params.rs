@@ -91,7 +91,8 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
 
 /// The side of the pair table the GPU holds for a law: 1 when every pair has the same
 /// coefficients (the stiffness form, or the material form without `pairs`), else the
-/// materials and the walls; None when it is larger than the GPU's table.
+/// materials and the walls; None when it is larger than the GPU's table. The rolling
+/// resistance's table (`rolling_params`) may widen it to the same side.
 pub fn gpu_pair_side(law: &ContactLaw) -> Option<usize> {
     let side = match law.pair_table() {
         Some(t) if t.coeffs.iter().any(|c| *c != t.coeffs[0]) => t.side,
@@ -210,13 +211,6 @@ pub(super) fn step_params(
         reorder: 1,
         list_cap: super::list_capacity(sim),
         max_step2: sim.scene.limits.max_step_displacement.powi(2) as f32,
-        rolling_mu: sim.rolling.mu_r as f32,
-        rolling_k: if sim.rolling.has_spring() {
-            sim.rolling.k_roll as f32
-        } else {
-            0.0
-        },
-        rolling_eta: sim.rolling.eta_r as f32,
         period_cells: if sim.scene.domain.periodic_x {
             grid.nx
         } else {
@@ -225,5 +219,36 @@ pub(super) fn step_params(
         ..Default::default()
     };
     law_params(law, &mut params);
+    rolling_params(&sim.rolling, &mut params);
     params
+}
+
+/// The rolling resistance's table into `Params.pair_law[2s + 1].yzw`, on the slots of the
+/// law's table: where the law has one entry and the rolling resistance a table, the
+/// law's entry is copied into every slot first. `rolling_mu` and `rolling_k` get the
+/// largest μ_r and spring k_roll, which choose the kernels' branches.
+pub fn rolling_params(rolling: &crate::law::rolling::RollingTable, p: &mut Params) {
+    let side = p.pair_side.max(1) as usize;
+    let side = if rolling.side > side {
+        let (a, b) = (p.pair_law[0], p.pair_law[1]);
+        for s in 0..rolling.side * rolling.side {
+            (p.pair_law[2 * s], p.pair_law[2 * s + 1]) = (a, b);
+        }
+        p.pair_side = rolling.side as u32;
+        rolling.side
+    } else {
+        side
+    };
+    for a in 0..side as u32 {
+        for b in 0..side as u32 {
+            let r = rolling.get(a, b);
+            let s = (a as usize) * side + b as usize;
+            let k_roll = if r.has_spring() { r.k_roll } else { 0.0 };
+            p.pair_law[2 * s + 1][1] = r.mu_r as f32;
+            p.pair_law[2 * s + 1][2] = k_roll as f32;
+            p.pair_law[2 * s + 1][3] = r.eta_r as f32;
+            p.rolling_mu = p.rolling_mu.max(r.mu_r as f32);
+            p.rolling_k = p.rolling_k.max(k_roll as f32);
+        }
+    }
 }

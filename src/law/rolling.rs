@@ -28,7 +28,7 @@
 use serde::{Deserialize, Serialize};
 
 /// The scene's `rolling` block.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RollingSpec {
     /// Which model: `constant_torque` (default) or `spring_dashpot`.
@@ -46,6 +46,54 @@ pub struct RollingSpec {
     /// (default 0.3, Ai et al.'s choice).
     #[serde(default)]
     pub damping: Option<f64>,
+    /// Pairs of materials with values of their own (LIGGGHTS' per-type-pair
+    /// `coefficientRollingFriction`): each key left out takes the block's.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub pairs: Vec<RollingPair>,
+}
+
+/// A pair of materials whose rolling resistance differs from the block's.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RollingPair {
+    /// Two material names; `"walls"` for the wall segments.
+    pub materials: [String; 2],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mu_r: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub stiffness: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub damping: Option<f64>,
+}
+
+impl RollingSpec {
+    /// The block's values with those a pair gives in their place (`pair` None: the
+    /// block's own).
+    pub fn with(&self, pair: Option<&RollingPair>) -> RollingSpec {
+        let Some(p) = pair else {
+            return RollingSpec {
+                pairs: Vec::new(),
+                ..self.clone()
+            };
+        };
+        RollingSpec {
+            model: self.model,
+            mu_r: p.mu_r.unwrap_or(self.mu_r),
+            stiffness: p.stiffness.or(self.stiffness),
+            damping: p.damping.or(self.damping),
+            pairs: Vec::new(),
+        }
+    }
+
+    /// Each set of values the block gives with the key it is given at: the block's own,
+    /// then each pair's.
+    pub fn entries(&self) -> Vec<(String, RollingSpec)> {
+        let mut out = vec![("rolling".to_string(), self.with(None))];
+        for (k, p) in self.pairs.iter().enumerate() {
+            out.push((format!("rolling.pairs[{k}]"), self.with(Some(p))));
+        }
+        out
+    }
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -111,6 +159,136 @@ impl Rolling {
     pub fn has_spring(&self) -> bool {
         !self.is_none() && self.k_roll > 0.0
     }
+}
+
+/// The rolling resistance of every pair of materials, like the material form's
+/// `PairTable` (src/law/restitution.rs): `side` = materials + 1, the last row and column
+/// for the walls; side 1 when every pair has the same. Symmetric; one model for all
+/// (the scene's `rolling.model`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RollingTable {
+    pub side: usize,
+    pub pairs: Vec<Rolling>,
+}
+
+impl Default for RollingTable {
+    fn default() -> Self {
+        RollingTable::uniform(Rolling::NONE)
+    }
+}
+
+impl RollingTable {
+    pub fn uniform(r: Rolling) -> Self {
+        RollingTable {
+            side: 1,
+            pairs: vec![r],
+        }
+    }
+
+    /// The scene's block resolved for its materials (`materials`: their names in index
+    /// order); `k_n` as in [`Rolling::of`]. None: a spring without a stiffness, or a
+    /// pair naming an unknown material (the scene's validation names the key).
+    pub fn of(
+        spec: Option<&RollingSpec>,
+        materials: &[String],
+        k_n: Option<f64>,
+    ) -> Option<RollingTable> {
+        let Some(s) = spec else {
+            return Some(RollingTable::default());
+        };
+        let all = Rolling::of(Some(&s.with(None)), k_n)?;
+        if s.pairs.is_empty() {
+            return Some(RollingTable::uniform(all));
+        }
+        let side = materials.len() + 1;
+        let mut pairs = vec![all; side * side];
+        for p in &s.pairs {
+            let r = Rolling::of(Some(&s.with(Some(p))), k_n)?;
+            let a = material_slot(materials, &p.materials[0])?;
+            let b = material_slot(materials, &p.materials[1])?;
+            pairs[a * side + b] = r;
+            pairs[b * side + a] = r;
+        }
+        Some(RollingTable { side, pairs })
+    }
+
+    /// The values of a contact between materials a and b (b = `walls()`: a wall).
+    #[inline(always)]
+    pub fn get(&self, a: u32, b: u32) -> &Rolling {
+        if self.side == 1 {
+            &self.pairs[0]
+        } else {
+            &self.pairs[a as usize * self.side + b as usize]
+        }
+    }
+
+    /// The index of the walls' row (the material index a wall contact looks up).
+    pub fn walls(&self) -> u32 {
+        self.side as u32 - 1
+    }
+
+    /// Whether no pair resists rolling.
+    pub fn is_none(&self) -> bool {
+        self.pairs.iter().all(Rolling::is_none)
+    }
+
+    /// Whether contacts keep a rolling spring (some pair under the spring–dashpot model).
+    pub fn has_spring(&self) -> bool {
+        self.pairs.iter().any(Rolling::has_spring)
+    }
+
+    /// What `talus check` says of it: the model, and the values of each pair of
+    /// materials (`materials`: their names in index order); nothing without.
+    pub fn describe(&self, materials: &[String]) -> Vec<String> {
+        if self.is_none() {
+            return Vec::new();
+        }
+        let values = |r: &Rolling| {
+            if r.is_none() {
+                "none".to_string()
+            } else if self.has_spring() {
+                format!(
+                    "μ_r = {}, k_roll = {:.4e}, η_r = {}",
+                    r.mu_r, r.k_roll, r.eta_r
+                )
+            } else {
+                format!("μ_r = {}", r.mu_r)
+            }
+        };
+        let model = if self.has_spring() {
+            "a rolling spring k_roll R*² with a dashpot at η_r of critical, plastic at μ_r R* f_n (Ai et al. 2011 model C)"
+        } else {
+            "constant torque μ_r R* f_n against the relative spin (Ai et al. 2011 model A)"
+        };
+        let head = format!(
+            "rolling resistance at disk contacts: {model} (R* = R_i R_j/(R_i + R_j), R_i at a wall; src/law/rolling.rs)"
+        );
+        if self.side == 1 {
+            return vec![format!("{head}, {}", values(&self.pairs[0]))];
+        }
+        let name = |k: usize| {
+            materials
+                .get(k)
+                .cloned()
+                .unwrap_or_else(|| super::spec::WALLS.to_string())
+        };
+        let mut out = vec![format!("{head}, per pair of materials (rolling.pairs):")];
+        for a in 0..self.side - 1 {
+            for b in a..self.side {
+                let r = self.get(a as u32, b as u32);
+                out.push(format!("  {}–{}: {}", name(a), name(b), values(r)));
+            }
+        }
+        out
+    }
+}
+
+/// The index of a material named in `rolling.pairs` (`materials.len()` for "walls").
+pub fn material_slot(materials: &[String], name: &str) -> Option<usize> {
+    if name == super::spec::WALLS {
+        return Some(materials.len());
+    }
+    materials.iter().position(|m| m == name)
 }
 
 /// The part of the torque that would stop the relative spin within one step which the
@@ -259,6 +437,7 @@ mod tests {
             mu_r: 0.2,
             stiffness: None,
             damping: None,
+            pairs: Vec::new(),
         };
         let r = Rolling::of(Some(&spec), Some(1e4)).unwrap();
         assert!((r.k_roll - 2.25 * 0.04 * 1e4).abs() < 1e-9);

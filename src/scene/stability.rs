@@ -111,29 +111,37 @@ pub(super) fn time_step(scene: &Scene, law: &ContactLaw) -> Result<Vec<String>, 
 /// ω² = k_r/I = 2 k_roll/m, half a period of which must last MIN_STEPS_PER_CONTACT
 /// steps (an error naming `rolling.stiffness`); and its dashpot, C_r/I = 4 η_r
 /// sqrt(1.5 k_roll/m) there, six at once, is held to `ROLLING_DAMPING_STABILITY` (a
-/// warning).
+/// warning). Each pair of `rolling.pairs` is held to it on its own, named by its key.
 fn rolling_spring_check(scene: &Scene, law: &ContactLaw) -> Result<Option<String>, SceneError> {
-    let rolling = crate::law::rolling::Rolling::of(scene.rolling.as_ref(), law.linear_k_n());
-    let (Some(r), Some(m)) = (rolling, lightest_mass(scene)) else {
+    let (Some(spec), Some(m)) = (&scene.rolling, lightest_mass(scene)) else {
         return Ok(None);
     };
-    if !r.has_spring() {
-        return Ok(None);
+    let mut worst: Option<(f64, String)> = None;
+    for (at, entry) in spec.entries() {
+        let Some(r) = crate::law::rolling::Rolling::of(Some(&entry), law.linear_k_n()) else {
+            continue;
+        };
+        if !r.has_spring() {
+            continue;
+        }
+        let t_r = std::f64::consts::PI / (2.0 * r.k_roll / m).sqrt();
+        if scene.dt > t_r / MIN_STEPS_PER_CONTACT {
+            return Err(SceneError::invalid(
+                format!("{at}.stiffness"),
+                format!(
+                    "{:.4e} is too stiff for dt = {}: the lightest disk's spin against a wall oscillates with half-period {t_r:.4e}, and dt must be at most a {MIN_STEPS_PER_CONTACT}th of it",
+                    r.k_roll, scene.dt
+                ),
+            ));
+        }
+        let ratio = 6.0 * 4.0 * r.eta_r * (1.5 * r.k_roll / m).sqrt() * scene.dt;
+        if ratio > ROLLING_DAMPING_STABILITY && worst.as_ref().is_none_or(|w| ratio > w.0) {
+            worst = Some((ratio, at));
+        }
     }
-    let t_r = std::f64::consts::PI / (2.0 * r.k_roll / m).sqrt();
-    if scene.dt > t_r / MIN_STEPS_PER_CONTACT {
-        return Err(SceneError::invalid(
-            "rolling.stiffness",
-            format!(
-                "{:.4e} is too stiff for dt = {}: the lightest disk's spin against a wall oscillates with half-period {t_r:.4e}, and dt must be at most a {MIN_STEPS_PER_CONTACT}th of it",
-                r.k_roll, scene.dt
-            ),
-        ));
-    }
-    let ratio = 6.0 * 4.0 * r.eta_r * (1.5 * r.k_roll / m).sqrt() * scene.dt;
-    Ok((ratio > ROLLING_DAMPING_STABILITY).then(|| {
+    Ok(worst.map(|(ratio, at)| {
         format!(
-            "6·C_r·dt/I = {ratio:.2} for the lightest disk exceeds {ROLLING_DAMPING_STABILITY}: Gear's predictor-corrector pumps energy into the rolling dashpots at this step (a heap that slumps); reduce dt, rolling.damping or rolling.stiffness"
+            "6·C_r·dt/I = {ratio:.2} for the lightest disk ({at}) exceeds {ROLLING_DAMPING_STABILITY}: Gear's predictor-corrector pumps energy into the rolling dashpots at this step (a heap that slumps); reduce dt, {at}.damping or {at}.stiffness"
         )
     }))
 }

@@ -457,13 +457,22 @@ fn periodic(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
 /// Rolling resistance (src/law/rolling.rs) acts at disk contacts: under the disk laws,
 /// which take disks only (polygons need the overlap-area law, rods `hertz_cohesive`).
 /// The spring model's keys belong to it, and its stiffness must be given where the law
-/// has no one k_n to take it from.
+/// has no one k_n to take it from; `pairs` name known materials, each pair once.
 fn rolling(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
     use crate::law::rolling::RollingModel;
     let Some(r) = &scene.rolling else {
         return Ok(());
     };
-    finite_non_negative("rolling.mu_r", r.mu_r)?;
+    rolling_pairs(scene, r)?;
+    for (at, r) in r.entries() {
+        finite_non_negative(&format!("{at}.mu_r"), r.mu_r)?;
+        if let Some(k) = r.stiffness {
+            finite_positive(&format!("{at}.stiffness"), k)?;
+        }
+        if let Some(eta) = r.damping {
+            finite_non_negative(&format!("{at}.damping"), eta)?;
+        }
+    }
     let name = match scene.contact {
         ContactSpec::OverlapArea(_) => Some("overlap_area"),
         ContactSpec::HertzCohesive(_) => Some("hertz_cohesive"),
@@ -477,29 +486,68 @@ fn rolling(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
             ),
         ));
     }
-    match r.model {
-        RollingModel::ConstantTorque => {
-            for (key, given) in [("stiffness", r.stiffness), ("damping", r.damping)] {
-                if given.is_some() {
+    // The keys each entry gives itself (a pair's others are the block's).
+    let own = |p: Option<&crate::law::rolling::RollingPair>| match p {
+        None => [("stiffness", r.stiffness), ("damping", r.damping)],
+        Some(p) => [("stiffness", p.stiffness), ("damping", p.damping)],
+    };
+    let entries = std::iter::once(("rolling".to_string(), None)).chain(
+        r.pairs
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (format!("rolling.pairs[{k}]"), Some(p))),
+    );
+    for (at, pair) in entries {
+        match r.model {
+            RollingModel::ConstantTorque => {
+                for (key, given) in own(pair) {
+                    if given.is_some() {
+                        return Err(SceneError::invalid(
+                            format!("{at}.{key}"),
+                            "belongs to the model \"spring_dashpot\" (the constant torque has no spring)",
+                        ));
+                    }
+                }
+            }
+            RollingModel::SpringDashpot => {
+                if r.with(pair).stiffness.is_none() && law.linear_k_n().is_none() {
                     return Err(SceneError::invalid(
-                        format!("rolling.{key}"),
-                        "belongs to the model \"spring_dashpot\" (the constant torque has no spring)",
+                        format!("{at}.stiffness"),
+                        "is required here: its default, 2.25 mu_r² k_n (Ai et al. 2011), needs the law's one linear k_n (law spring_dashpot with k_n and nu = 1)",
                     ));
                 }
             }
         }
-        RollingModel::SpringDashpot => {
-            if let Some(k) = r.stiffness {
-                finite_positive("rolling.stiffness", k)?;
-            } else if law.linear_k_n().is_none() {
-                return Err(SceneError::invalid(
-                    "rolling.stiffness",
-                    "is required here: its default, 2.25 mu_r² k_n (Ai et al. 2011), needs the law's one linear k_n (law spring_dashpot with k_n and nu = 1)",
-                ));
-            }
-            if let Some(eta) = r.damping {
-                finite_non_negative("rolling.damping", eta)?;
-            }
+    }
+    Ok(())
+}
+
+/// `rolling.pairs` name known materials (or "walls"), each unordered pair once, and not
+/// walls with walls.
+fn rolling_pairs(scene: &Scene, r: &crate::law::rolling::RollingSpec) -> Result<(), SceneError> {
+    use crate::law::rolling::material_slot;
+    use crate::law::spec::WALLS;
+    let materials: Vec<String> = scene.materials.keys().cloned().collect();
+    let mut seen = std::collections::BTreeSet::new();
+    for (k, p) in r.pairs.iter().enumerate() {
+        let at = format!("rolling.pairs[{k}].materials");
+        let slot = |name: &str| {
+            material_slot(&materials, name).ok_or_else(|| {
+                SceneError::invalid(
+                    &at,
+                    format!(
+                        "unknown material \"{name}\" (known: {}, and \"{WALLS}\")",
+                        materials.join(", ")
+                    ),
+                )
+            })
+        };
+        let (a, b) = (slot(&p.materials[0])?, slot(&p.materials[1])?);
+        if a == materials.len() && b == materials.len() {
+            return Err(SceneError::invalid(&at, "walls do not touch walls"));
+        }
+        if !seen.insert((a.min(b), a.max(b))) {
+            return Err(SceneError::invalid(&at, "this pair is listed twice"));
         }
     }
     Ok(())

@@ -13,7 +13,7 @@ use crate::cpu::springs::SpringTable;
 use crate::create::{self, source::SourceState};
 use crate::integrate::{gear, leapfrog};
 use crate::law::ContactLaw;
-use crate::law::rolling::Rolling;
+use crate::law::rolling::RollingTable;
 use crate::scene::{IntegratorKind, Scene, SceneError};
 use crate::state::{Dof, Particles};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -43,8 +43,8 @@ pub struct Simulation {
     pub walls: Vec<WallSegment>,
     /// Each wall's surface velocity (scene `walls[k].velocity`, along the wall).
     pub wall_velocity: Vec<[f64; 2]>,
-    /// Rolling resistance at disk contacts (scene `rolling`).
-    pub rolling: Rolling,
+    /// Rolling resistance at disk contacts, per pair of materials (scene `rolling`).
+    pub rolling: RollingTable,
     pub grid: Grid,
     pub particles: Particles,
     /// The tangential springs the state was created with (a checkpoint's, or the GPU
@@ -172,7 +172,12 @@ impl Simulation {
         let grid = Grid::new(scene.domain.x, scene.domain.z, law.range_factor() * max_d);
         Ok(Self {
             // Validated: a spring has its stiffness (`scene::validate`).
-            rolling: Rolling::of(scene.rolling.as_ref(), law.linear_k_n()).unwrap_or(Rolling::NONE),
+            rolling: RollingTable::of(
+                scene.rolling.as_ref(),
+                &scene.materials.keys().cloned().collect::<Vec<_>>(),
+                law.linear_k_n(),
+            )
+            .unwrap_or_default(),
             scene,
             law,
             walls,
@@ -389,7 +394,7 @@ impl Simulation {
             wall_velocity: &self.wall_velocity,
             dt: self.scene.dt,
             pair_side: self.law.pair_table().map_or(0, |t| t.side),
-            rolling: self.rolling,
+            rolling: &self.rolling,
         };
         candidate_forces(
             &state,

@@ -11,7 +11,7 @@ use crate::base::geometry::{Geometry, WallSegment, tangent};
 use crate::cpu::contacts::Pair;
 use crate::cpu::orientation::RotatedCorners;
 use crate::law::rolling::{
-    Rolling, rolling_inertia_inv, rolling_radius, rolling_spring, rolling_torque,
+    RollingTable, rolling_inertia_inv, rolling_radius, rolling_spring, rolling_torque,
 };
 use crate::law::{ContactInput, ContactLaw, ContactOutput};
 use crate::state::{Dof, Particles, offset};
@@ -67,8 +67,8 @@ pub struct StepState<'a> {
     pub dt: f64,
     /// The side of the material form's pair table (src/law/restitution.rs); 0 without.
     pub pair_side: usize,
-    /// Rolling resistance at disk contacts (scene `rolling`).
-    pub rolling: Rolling,
+    /// Rolling resistance at disk contacts, per pair of materials (scene `rolling`).
+    pub rolling: &'a RollingTable,
 }
 
 /// Stage: the velocity (vx, vz, ω) = q1/dt of every particle.
@@ -87,7 +87,7 @@ pub fn contact_forces(
     walls: &[WallSegment],
     wall_velocity: &[[f64; 2]],
     law: &ContactLaw,
-    rolling: Rolling,
+    rolling: &RollingTable,
     dt: f64,
     pairs: &[Pair],
     history_in: &[f64],
@@ -173,15 +173,19 @@ fn rolling(s: &StepState, pair: Pair, f_n: f64, spring: f64) -> (f64, f64) {
     let p = s.particles;
     let i = pair.i as usize;
     let j = (!pair.is_wall()).then_some(pair.j as usize);
+    let r = s.rolling.get(
+        p.material[i],
+        j.map_or(s.rolling.walls(), |j| p.material[j]),
+    );
     let spin = s.velocity[i][2] - j.map_or(0.0, |j| s.velocity[j][2]);
     let r_roll = rolling_radius(p.radius[i], j.map(|j| p.radius[j]));
     if s.rolling.has_spring() {
         let inv = |k: usize| rolling_inertia_inv(p.inertia[k], p.mass[k], p.radius[k], p.fixed[k]);
         let inv_r = inv(i) + j.map_or(0.0, inv);
-        return rolling_spring(&s.rolling, spring, spin, r_roll, f_n, inv_r, s.dt);
+        return rolling_spring(r, spring, spin, r_roll, f_n, inv_r, s.dt);
     }
     let inv_inertia = |k: usize| if p.fixed[k] { 0.0 } else { 1.0 / p.inertia[k] };
     let inv = inv_inertia(i) + j.map_or(0.0, inv_inertia);
-    let m = rolling_torque(s.rolling.mu_r, spin, r_roll, f_n, inv, s.dt);
+    let m = rolling_torque(r.mu_r, spin, r_roll, f_n, inv, s.dt);
     (m, 0.0)
 }
