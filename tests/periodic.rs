@@ -210,6 +210,138 @@ fn a_periodic_layer_is_sheared_by_a_moving_wall_through_the_seam() {
     }
 }
 
+/// The force on the grains from each wall (summed over its contacts) at the state's
+/// step.
+fn wall_forces(s: &talus::sim::Simulation, walls: usize) -> Vec<[f64; 2]> {
+    let mut f = vec![[0.0; 2]; walls];
+    for (p, c) in s.pairs.iter().zip(&s.contacts) {
+        if p.is_wall() {
+            let w = (p.j - talus::cpu::contacts::WALL_BASE) as usize;
+            f[w] = [f[w][0] + c.force[0], f[w][1] + c.force[1]];
+        }
+    }
+    f
+}
+
+/// What a layer between a still floor and a top wall moving along x at `u` does from
+/// t = 1 to 3 (see `a_periodic_layer_is_dragged_by_a_moving_top_wall`): its momentum's
+/// change ΔP_x, the walls' x impulse over the same steps (trapezoid) and the size of
+/// their impulses, the top wall's impulse, and the rows' mean speeds at t = 3; None on
+/// the GPU path without an adapter. Checks Coulomb at both walls at every step.
+fn couette(path: Path, u: f64) -> Option<([f64; 4], Vec<f64>)> {
+    // Five rows of 12 disks (d = 0.98) in each other's hollows, sqrt(0.98² − 0.5²)
+    // apart, the top wall 1e-2 into the top row.
+    let rise = (0.98f64 * 0.98 - 0.25).sqrt();
+    let top = 0.49 + rise * 4.0 + 0.49 - 1e-2;
+    let mut disks = Vec::new();
+    for row in 0..5 {
+        for k in 0..12 {
+            let x = 0.5 + k as f64 + 0.5 * (row % 2) as f64;
+            disks.push(json!({ "position": [x, 0.49 + rise * row as f64], "diameter": 0.98 }));
+        }
+    }
+    let mut v = dragged_layer(0.0);
+    v["particles"][0]["particles"] = json!(disks);
+    v["walls"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({ "from": [0.0, top], "to": [L, top], "velocity": [u, 0.0] }));
+    let mut e = engine(path, "periodic_couette", sim(&v))?;
+    let dt = e.sim().unwrap().dt();
+    let momentum = |s: &talus::sim::Simulation| {
+        let p = &s.particles;
+        (0..p.len())
+            .map(|i| p.mass[i] * p.velocity(i, dt)[0])
+            .sum::<f64>()
+    };
+    e.advance(1000).unwrap();
+    let s = e.sim().unwrap();
+    let p1 = momentum(s);
+    let mut last = wall_forces(s, 2);
+    let (mut impulse, mut size, mut top_x) = (0.0, 0.0, 0.0);
+    for _ in 0..2000 {
+        e.advance(1).unwrap();
+        let s = e.sim().unwrap();
+        let f = wall_forces(s, 2);
+        for (w, [fx, fz]) in f.iter().enumerate() {
+            // Each contact |f_t| ≤ μ f_n, its normal along z: so does the sum.
+            assert!(
+                fx.abs() <= MU * fz.abs() * (1.0 + 1e-6) + 1e-9,
+                "{path:?}, wall {w} at step {}: F_x {fx} beyond μ |F_z| = {}",
+                s.step,
+                MU * fz.abs()
+            );
+        }
+        let x = |f: &[[f64; 2]]| [f[0][0] + f[1][0], f[0][0].abs() + f[1][0].abs(), f[1][0]];
+        let (now, before) = (x(&f), x(&last));
+        impulse += 0.5 * (now[0] + before[0]) * dt;
+        size += 0.5 * (now[1] + before[1]) * dt;
+        top_x += 0.5 * (now[2] + before[2]) * dt;
+        last = f;
+    }
+    let s = e.sim().unwrap();
+    assert_eq!(s.lost, 0, "{path:?}: grains lost");
+    let p = &s.particles;
+    let row = |r: usize| (0..12).map(|k| p.velocity(r * 12 + k, dt)[0]).sum::<f64>() / 12.0;
+    Some((
+        [momentum(s) - p1, impulse, size, top_x],
+        (0..5).map(row).collect(),
+    ))
+}
+
+#[test]
+fn a_periodic_layer_is_dragged_by_a_moving_top_wall() {
+    // Plane Couette: a layer between a still floor and a top wall at a fixed height
+    // pressing on it, whose surface moves at U = 1 along x. With no side walls (the
+    // period closes the layer) only the two walls push it along x, so its momentum
+    // obeys dP_x/dt = F_top + F_floor: integrated step by step from t = 1 to 3 it gives
+    // ΔP_x to 1e-3 of the impulses' size. Coulomb holds at each wall (|F_x| ≤ μ |F_z|,
+    // summed over its contacts, every step); the top wall drags the layer forward, and
+    // the layer stays slower than it. With the top wall still, the layer stays at rest.
+    // Measured on the CPU: the balance to 2e-6 of the impulses (ΔP_x 11.98 of 220.8),
+    // the top wall's impulse 6.5, the rows at 0.60–0.63 at t = 3 (the lattice rolls
+    // along as a plug, its rows spinning, rather than shearing); the GPU (lavapipe):
+    // the balance to 2e-6 as well and the rows within 2e-4 of the CPU's.
+    let mut cpu: Option<Vec<f64>> = None;
+    for path in PATHS {
+        let Some(([change, impulse, size, top_x], rows)) = couette(path, 1.0) else {
+            continue;
+        };
+        eprintln!(
+            "{path:?}: ΔP_x {change:.6} against the walls' impulse {impulse:.6} (of {size:.3}); the top wall's {top_x:.4}; rows at t = 3, floor to top: {rows:.4?}"
+        );
+        assert!(
+            (change - impulse).abs() < 1e-3 * size,
+            "{path:?}: ΔP_x {change} against the walls' impulse {impulse}"
+        );
+        assert!(
+            top_x > 0.1 && change > 0.1,
+            "{path:?}: the top wall's impulse {top_x}, ΔP_x {change}"
+        );
+        assert!(
+            rows.iter().all(|&r| r > 0.0 && r < 1.0),
+            "{path:?}: rows {rows:?} not between the floor and the wall"
+        );
+        match &cpu {
+            None => cpu = Some(rows),
+            Some(c) => {
+                let off = rows
+                    .iter()
+                    .zip(c)
+                    .map(|(a, b)| (a - b).abs())
+                    .fold(0.0, f64::max);
+                assert!(off < 1e-2, "GPU rows {rows:?} against CPU {c:?}");
+            }
+        }
+    }
+    let (still, rows) = couette(Path::Cpu, 0.0).unwrap();
+    eprintln!("top wall still: ΔP_x {:.2e}, rows {rows:?}", still[0]);
+    assert!(
+        still[0].abs() < 1e-6 && rows.iter().all(|r| r.abs() < 1e-6),
+        "with the top wall still the layer moves: {still:?}, {rows:?}"
+    );
+}
+
 #[test]
 fn polygons_touch_across_the_seam_alike_on_both_paths() {
     // Two rows of pentagons on a floor moving at 2 along x, so that they are dragged
