@@ -31,7 +31,7 @@ fn offset_units(o: Offset) -> vec2<f32> {
 // The area contact of particle i with wall w, in length units in i's frame.
 fn polygon_wall_iw(i: u32, w: u32) -> AreaContact {
     let s = state[i];
-    let wall = walls[w];
+    let wall = wall_at(w);
     let oa = offset(wall.a_anchor, wall.a_frac, wall.a_rem, s.anchor, s.frac, s.q[0].xy);
     let ob = offset(wall.b_anchor, wall.b_frac, wall.b_rem, s.anchor, s.frac, s.q[0].xy);
     let l = wall_line(i, w);

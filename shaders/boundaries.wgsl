@@ -24,11 +24,14 @@ fn leave_domain(i: u32, s: State) {
 @compute @workgroup_size(1)
 fn advance_clock() {
     if (!halted()) {
-        atomicAdd(&control[C_STEP], 1u);
+        let step = atomicAdd(&control[C_STEP], 1u);
         // The lists are current; what the next step needs is asked for again, but a
         // removal at the end of this one, or the survey of its prediction run ahead,
         // already asks for a rebuild.
-        if (rebuilding()) { atomicAdd(&control[C_REBUILDS], 1u); }
+        if (rebuilding()) {
+            atomicAdd(&control[C_REBUILDS], 1u);
+            atomicStore(&control[C_WALLS_LISTED], step);
+        }
         let next = (lists_word() & (REMOVED | AHEAD_REBUILD)) != 0u;
         atomicStore(&control[C_LISTS], select(0u, REBUILD, next));
         atomicStore(&control[C_STAGED], 0u);

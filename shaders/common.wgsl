@@ -40,7 +40,10 @@ const C_STAGED: u32 = 8u;
 // Inactive particles counted by cell_index at a rebuild (they go last in the new memory
 // order, `permute_gather`).
 const C_INACTIVE: u32 = 9u;
-const C_BLOCKED: u32 = 10u;
+// The step whose lists were built last (`advance_clock`): moving walls ask for a
+// rebuild once they have moved by half the skin since then (`walls_moved`).
+const C_WALLS_LISTED: u32 = 10u;
+const C_BLOCKED: u32 = 11u;
 // control[C_LISTS]: REBUILD, the lists are rebuilt this step (a particle moved more
 // than skin/2, or was inserted or removed, or the state was uploaded); TABLE_CURRENT,
 // the spring table holds the springs (an upload: the first rebuild takes them from it
@@ -205,6 +208,12 @@ struct Wall {
     beta: f32,          // nq/2^30 = (1 + alpha) n + beta t: its turn off the true normal
     alpha: f32,         // and its stretch
     velocity: vec2<f32>, // the surface's velocity, along the wall (scene walls[k].velocity)
+    // The segment's own motion (scene walls[k].motion): a constant velocity, and an
+    // oscillation's amplitude and 2 pi / T (0: none); the ends above are at t = 0.
+    motion_v: vec2<f32>,
+    amplitude: vec2<f32>,
+    omega: f32,
+    pad: u32,
 };
 
 struct Entry {
@@ -306,6 +315,58 @@ fn is_integrated(i: u32) -> bool {
 // `keeps_sub_springs`): spheropolygons' sub-contact springs, or rolling springs.
 fn sub_springs_kept() -> bool {
     return params.law == LAW_HERTZ || params.rolling_k > 0.0;
+}
+
+// --- Walls that move (scene walls[k].motion; src/sim/walls.rs) ---
+
+// The time of the contacts evaluated in step `step`: Gear evaluates them at the
+// predicted state, t + dt, leapfrog at t (src/sim/mod.rs `step_with`).
+fn contact_time_of(step: u32) -> f32 {
+    return f32(step + select(0u, 1u, params.integrator == 0u)) * params.dt;
+}
+
+// The time of this step's contacts.
+fn contact_time() -> f32 {
+    return contact_time_of(atomicLoad(&control[C_STEP]));
+}
+
+fn wall_moves(w: u32) -> bool {
+    return any(walls[w].motion_v != vec2<f32>(0.0)) || walls[w].omega != 0.0;
+}
+
+// Twin of src/scene/schema.rs `WallMotion::displacement`: wall w's displacement at time
+// t from its ends at t = 0, v t + A sin(omega t).
+fn wall_displacement(w: u32, t: f32) -> vec2<f32> {
+    let m = walls[w];
+    return m.motion_v * t + m.amplitude * sin(m.omega * t);
+}
+
+// Twin of src/scene/schema.rs `WallMotion::velocity_at`.
+fn wall_motion_velocity(w: u32, t: f32) -> vec2<f32> {
+    let m = walls[w];
+    return m.motion_v + m.amplitude * (m.omega * cos(m.omega * t));
+}
+
+// The velocity wall w's contacts see in this step: its surface's along it, plus the
+// segment's own.
+fn wall_velocity(w: u32) -> vec2<f32> {
+    if (!wall_moves(w)) { return walls[w].velocity; }
+    return walls[w].velocity + wall_motion_velocity(w, contact_time());
+}
+
+// Twin of src/sim/walls.rs `walls_moved`: whether at the contacts of step `step` a wall
+// has moved by more than skin/2 since the lists were built (control[C_WALLS_LISTED]);
+// a hair less than skin/2 for f32's rounding, so never later than the CPU path.
+fn walls_moved(step: u32) -> bool {
+    let listed = contact_time_of(atomicLoad(&control[C_WALLS_LISTED]));
+    let now = contact_time_of(step);
+    let half = 0.5 * params.skin * (1.0 - 1.0e-4);
+    for (var w = 0u; w < params.n_walls; w++) {
+        if (!wall_moves(w)) { continue; }
+        let d = wall_displacement(w, now) - wall_displacement(w, listed);
+        if (dot(d, d) > half * half) { return true; }
+    }
+    return false;
 }
 
 fn halted() -> bool {

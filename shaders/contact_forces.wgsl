@@ -156,7 +156,7 @@ fn candidate_force(i: u32, slot: u32, ri: f32, m1: f32, v1: vec3<f32>) {
         mass = 2.0 * m12;
     } else if (WALLS) {
         // A wall's surface moves along it (scene walls[k].velocity).
-        v2 = vec3<f32>(walls[j - WALL_BASE].velocity, 0.0);
+        v2 = vec3<f32>(wall_velocity(j - WALL_BASE), 0.0);
     }
     // The law sees the rate of delta: the overlap's for disks, L v_n / l for the
     // overlap area (delta = A/l; src/cpu/forces/kinematics.rs `area_kinematics`).

@@ -63,7 +63,7 @@ fn disks_area_ij(i: u32, j: u32) -> AreaContact {
 // chord that lies over the wall (an approximation at the wall's ends, as on the CPU).
 fn disk_wall_area(i: u32, w: u32) -> AreaContact {
     let s = state[i];
-    let wall = walls[w];
+    let wall = wall_at(w);
     let r = props[i].radius;
     let oa = offset(s.anchor, s.frac, s.q[0].xy, wall.a_anchor, wall.a_frac, wall.a_rem);
     let p = offset_vector(oa);   // centre - a

@@ -74,7 +74,7 @@ struct WallLine {
 
 fn wall_line(i: u32, w: u32) -> WallLine {
     let s = state[i];
-    let wall = walls[w];
+    let wall = wall_at(w);
     let t = wall.ab / max(length(wall.ab), 1.0e-30);
     var n = vec2<f32>(-t.y, t.x);
     var q = wall.nq;
@@ -112,7 +112,7 @@ fn wall_depth(l: WallLine, r_units: u32, r_rem: f32) -> f32 {
 fn disk_wall(i: u32, w: u32) -> Geometry {
     let s = state[i];
     let pr = props[i];
-    let wall = walls[w];
+    let wall = wall_at(w);
     let oa = offset(s.anchor, s.frac, s.q[0].xy, wall.a_anchor, wall.a_frac, wall.a_rem);
     let p = offset_vector(oa);
     let ab = wall.ab;
@@ -138,4 +138,24 @@ fn disk_wall(i: u32, w: u32) -> Geometry {
     g.sigma = 2.0 * radius;
     g.r = g.sigma - 2.0 * g.delta;
     return g;
+}
+
+// Wall w placed at the time of this step's contacts (src/sim/walls.rs `place_walls`):
+// its ends at t = 0 moved by its displacement, in fixed point (to f32's precision of
+// the displacement, `renormalize_axis`); a wall that does not move as it is.
+fn wall_at(w: u32) -> Wall {
+    var wall = walls[w];
+    if (!wall_moves(w)) { return wall; }
+    let d = wall_displacement(w, contact_time()) * params.inv_unit;
+    let ax = renormalize_axis(wall.a_rem.x + d.x, wall.a_anchor.x, wall.a_frac.x);
+    let az = renormalize_axis(wall.a_rem.y + d.y, wall.a_anchor.y, wall.a_frac.y);
+    let bx = renormalize_axis(wall.b_rem.x + d.x, wall.b_anchor.x, wall.b_frac.x);
+    let bz = renormalize_axis(wall.b_rem.y + d.y, wall.b_anchor.y, wall.b_frac.y);
+    wall.a_anchor = vec2<i32>(ax.anchor, az.anchor);
+    wall.a_frac = vec2<u32>(ax.frac, az.frac);
+    wall.a_rem = vec2<f32>(ax.rem, az.rem);
+    wall.b_anchor = vec2<i32>(bx.anchor, bz.anchor);
+    wall.b_frac = vec2<u32>(bx.frac, bz.frac);
+    wall.b_rem = vec2<f32>(bx.rem, bz.rem);
+    return wall;
 }

@@ -156,7 +156,7 @@ fn vertex_edge(v: Point, a: Point, b: Point, sig_w: i32, sig_r: f32, gap: f32,
 fn vertex_wall(l: WallLine, w: u32, i: u32, corner: vec2<i32>, ce: vec2<f32>, r_units: i32,
                r_rem: f32, gap: f32) -> Sub {
     var s = Sub(0u, 0.0, l.n, vec2<f32>(0.0), 0u, false);
-    let wall = walls[w];
+    let wall = wall_at(w);
     let st = state[i];
     let oa = offset(st.anchor, st.frac, st.q[0].xy, wall.a_anchor, wall.a_frac, wall.a_rem);
     let cf = vec2<f32>(corner) + ce;
@@ -266,7 +266,7 @@ fn wall_subs(i: u32, w: u32, gap: f32) -> Subs {
     var subs: Subs;
     subs.count = 0u;
     let p = load_core(i, vec2<i32>(0), vec2<f32>(0.0));
-    let wall = walls[w];
+    let wall = wall_at(w);
     let st = state[i];
     let oa = offset(wall.a_anchor, wall.a_frac, wall.a_rem, st.anchor, st.frac, st.q[0].xy);
     let ob = offset(wall.b_anchor, wall.b_frac, wall.b_rem, st.anchor, st.frac, st.q[0].xy);
@@ -329,7 +329,7 @@ fn spheropolygon_force(i: u32, slot: u32, m1: f32, v1: vec3<f32>) {
         } else {
             subs.count = 0u;
         }
-        v2 = vec3<f32>(walls[j - WALL_BASE].velocity, 0.0);
+        v2 = vec3<f32>(wall_velocity(j - WALL_BASE), 0.0);
     } else if (!circles_near(i, j)) {
         subs.count = 0u;
     } else {

@@ -38,6 +38,12 @@ fn survey_one_at(i: u32, bit: u32, s: State) {
         return;
     }
     if (is_active(i) && moved(s)) { atomicOr(&control[C_LISTS], bit); }
+    // Moving walls (src/sim/walls.rs), once per survey: at the step surveyed (the next
+    // one for a prediction run ahead).
+    if (i == 0u && params.n_walls > 0u) {
+        let step = atomicLoad(&control[C_STEP]) + select(0u, 1u, bit == AHEAD_REBUILD);
+        if (walls_moved(step)) { atomicOr(&control[C_LISTS], bit); }
+    }
 }
 
 @compute @workgroup_size(WG)

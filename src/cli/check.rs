@@ -49,12 +49,25 @@ pub(super) fn cmd_check(
             d.x[1]
         );
     }
-    for (k, v) in sim.wall_velocity.iter().enumerate() {
+    for (k, w) in sim.scene.walls.iter().enumerate() {
+        let v = w.velocity;
         if v[0] != 0.0 || v[1] != 0.0 {
             out!(
-                "wall {k}: its surface moves along it at ({}, {}) (walls[{k}].velocity); the segment stays in place",
+                "wall {k}: its surface moves along it at ({}, {}) (walls[{k}].velocity)",
                 v[0],
                 v[1]
+            );
+        }
+        if let Some(m) = w.motion {
+            let period = m.period.filter(|_| m.omega() != 0.0);
+            out!(
+                "wall {k}: the segment moves by v t + A sin(2π t / T) (walls[{k}].motion), v = ({}, {}), A = ({}, {}), T = {}; top speed {:.4e}; the neighbour lists are rebuilt once it has moved by half the skin",
+                m.velocity[0],
+                m.velocity[1],
+                m.amplitude[0],
+                m.amplitude[1],
+                period.map_or("none".to_string(), |p| p.to_string()),
+                m.top_speed()
             );
         }
     }

@@ -95,6 +95,7 @@ pub fn shared() -> Vec<(&'static str, Value)> {
         u("C_REBUILDS", c::REBUILDS),
         u("C_STAGED", c::STAGED),
         u("C_INACTIVE", c::INACTIVE),
+        u("C_WALLS_LISTED", c::WALLS_LISTED),
         u("C_BLOCKED", c::BLOCKED),
         u("REBUILD", c::REBUILD),
         u("TABLE_CURRENT", c::TABLE_CURRENT),

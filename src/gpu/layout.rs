@@ -68,7 +68,10 @@ pub mod control {
     pub const STAGED: usize = 8;
     /// Inactive particles counted at a rebuild (`C_INACTIVE`).
     pub const INACTIVE: usize = 9;
-    pub const BLOCKED: usize = 10;
+    /// The step whose lists were built last (`C_WALLS_LISTED`): moving walls ask for a
+    /// rebuild once they have moved by half the skin since then.
+    pub const WALLS_LISTED: usize = 10;
+    pub const BLOCKED: usize = 11;
     pub const HALT_OVERLAP: u32 = 1;
     pub const HALT_NOT_FINITE: u32 = 2;
     pub const HALT_CONTACTS_FULL: u32 = 4;
@@ -242,6 +245,14 @@ pub struct Wall {
     pub alpha: f32,
     /// The surface's velocity, along the wall (scene `walls[k].velocity`).
     pub velocity: [f32; 2],
+    /// The segment's own motion (scene `walls[k].motion`, src/scene/schema.rs
+    /// `WallMotion`): its constant velocity, and its oscillation's amplitude and 2π/T
+    /// (0: none). The ends above are the segment's at t = 0 (`wall_at` in geometry.wgsl
+    /// places it).
+    pub motion_v: [f32; 2],
+    pub amplitude: [f32; 2],
+    pub omega: f32,
+    pub pad: u32,
 }
 
 #[repr(C)]
@@ -395,7 +406,8 @@ pub fn offsets() -> Vec<(&'static str, usize, Vec<(&'static str, usize)>)> {
             Wall,
             "Wall",
             [
-                a_anchor, a_frac, a_rem, b_anchor, b_frac, b_rem, ab, nq, beta, alpha, velocity
+                a_anchor, a_frac, a_rem, b_anchor, b_frac, b_rem, ab, nq, beta, alpha, velocity,
+                motion_v, amplitude, omega, pad
             ]
         ),
         fields!(Entry, "Entry", [i, j, value, _pad]),

@@ -370,7 +370,7 @@ impl GpuSimulation {
             .into());
         }
         debug_assert_eq!(needs.list_cap, params.list_cap);
-        let walls = device_walls(&sim.walls, &sim.wall_velocity, origin, cell_size);
+        let walls = device_walls(&sim.scene.walls, origin, cell_size);
 
         let control = initial_control(sim.step, n_now, up.sources.len());
         let (states, props, entries, subs) = initial_state(&sim, device_state, origin, cell_size);

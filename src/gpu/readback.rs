@@ -110,6 +110,7 @@ impl GpuSimulation {
         let p = from_device(&ds.states, &ds.props, self.origin, cell, &self.corner_table);
         self.sim.particles = p;
         self.sim.step = self.step;
+        self.sim.place_walls(self.sim.time());
         self.sim.lost = self.lost_base + c[control::LOST] as u64;
         let mut table = SpringTable::with_capacity_for(ds.springs.len());
         for (k, e) in ds.springs.iter().enumerate() {

@@ -302,20 +302,22 @@ pub fn table_lookup(table: &[Entry], i: u32, j: u32) -> Option<f32> {
 
 /// The walls in the device's layout: both ends in fixed point, the exact normal.
 pub(super) fn device_walls(
-    walls: &[crate::base::geometry::WallSegment],
-    velocity: &[[f64; 2]],
+    walls: &[crate::scene::Wall],
     origin: [f64; 2],
     cell_size: f32,
 ) -> Vec<Wall> {
     walls
         .iter()
-        .zip(velocity)
-        .map(|(w, v)| {
+        .map(|w| {
+            // The segment at t = 0: `wall_at` in geometry.wgsl moves it.
+            let seg = crate::base::geometry::WallSegment { a: w.from, b: w.to };
             let (a_anchor, a_frac, a_rem) =
-                position::split2(w.a[0] - origin[0], w.a[1] - origin[1], cell_size);
+                position::split2(seg.a[0] - origin[0], seg.a[1] - origin[1], cell_size);
             let (b_anchor, b_frac, b_rem) =
-                position::split2(w.b[0] - origin[0], w.b[1] - origin[1], cell_size);
-            let (nq, beta, alpha) = wall_normal(w);
+                position::split2(seg.b[0] - origin[0], seg.b[1] - origin[1], cell_size);
+            let (nq, beta, alpha) = wall_normal(&seg);
+            let m = w.motion.unwrap_or_default();
+            let f = |v: [f64; 2]| [v[0] as f32, v[1] as f32];
             Wall {
                 a_anchor,
                 a_frac,
@@ -323,11 +325,15 @@ pub(super) fn device_walls(
                 b_anchor,
                 b_frac,
                 b_rem,
-                ab: [(w.b[0] - w.a[0]) as f32, (w.b[1] - w.a[1]) as f32],
+                ab: [(seg.b[0] - seg.a[0]) as f32, (seg.b[1] - seg.a[1]) as f32],
                 nq,
                 beta,
                 alpha,
-                velocity: [v[0] as f32, v[1] as f32],
+                velocity: f(w.velocity),
+                motion_v: f(m.velocity),
+                amplitude: f(m.amplitude),
+                omega: m.omega() as f32,
+                pad: 0,
             }
         })
         .collect()

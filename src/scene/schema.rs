@@ -186,10 +186,11 @@ pub struct PolygonSpec {
     pub irregular: bool,
 }
 
-/// A fixed straight wall segment.
+/// A straight wall segment, fixed unless it has a `motion`.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Wall {
+    /// The segment's ends at t = 0.
     pub from: [f64; 2],
     pub to: [f64; 2],
     /// The velocity of the wall's surface, along the wall (a belt, or a wall shearing
@@ -197,6 +198,56 @@ pub struct Wall {
     /// of the wall's contacts; the segment itself stays where it is.
     #[serde(default, skip_serializing_if = "at_rest")]
     pub velocity: [f64; 2],
+    /// The segment's own motion, without turning (a piston, a pushing or an oscillating
+    /// wall; LAMMPS `fix wall/gran ... wiggle`, `fix move linear`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub motion: Option<WallMotion>,
+}
+
+/// A wall's translation: by v t + A sin(2π t / T) at time t, so with the velocity
+/// v + A (2π/T) cos(2π t / T), which its contacts see added to the surface's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WallMotion {
+    /// v, a constant velocity.
+    #[serde(default)]
+    pub velocity: [f64; 2],
+    /// A, the amplitude of an oscillation (a displacement), with `period` T.
+    #[serde(default)]
+    pub amplitude: [f64; 2],
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
+}
+
+impl WallMotion {
+    /// 2π/T, 0 without an oscillation.
+    pub fn omega(&self) -> f64 {
+        match self.period {
+            Some(p) if self.amplitude != [0.0; 2] => std::f64::consts::TAU / p,
+            _ => 0.0,
+        }
+    }
+
+    /// The displacement at time t from the segment at t = 0. Twin of
+    /// `wall_displacement` in shaders/geometry.wgsl.
+    pub fn displacement(&self, t: f64) -> [f64; 2] {
+        let (v, a, s) = (self.velocity, self.amplitude, (self.omega() * t).sin());
+        [v[0] * t + a[0] * s, v[1] * t + a[1] * s]
+    }
+
+    /// The segment's velocity at time t. Twin of `wall_motion_velocity` in
+    /// shaders/geometry.wgsl.
+    pub fn velocity_at(&self, t: f64) -> [f64; 2] {
+        let w = self.omega();
+        let (v, a, c) = (self.velocity, self.amplitude, w * (w * t).cos());
+        [v[0] + a[0] * c, v[1] + a[1] * c]
+    }
+
+    /// Its largest speed.
+    pub fn top_speed(&self) -> f64 {
+        let w = self.omega();
+        self.velocity[0].hypot(self.velocity[1]) + w * self.amplitude[0].hypot(self.amplitude[1])
+    }
 }
 
 fn at_rest(v: &[f64; 2]) -> bool {

@@ -260,18 +260,26 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
                 format!("must be finite, got {v:?}"),
             ));
         }
-        // Only along the wall: a wall moving across its line would move its contacts and
-        // its neighbour lists, which talus does not do yet.
+        // Only along the wall: the segment's own motion is `motion`.
         let t = [w.to[0] - w.from[0], w.to[1] - w.from[1]];
         let across = (t[0] * v[1] - t[1] * v[0]).abs();
         if across > 1e-9 * t[0].hypot(t[1]) * v[0].hypot(v[1]) {
             return Err(SceneError::invalid(
                 format!("walls[{k}].velocity"),
                 format!(
-                    "{v:?} is not along the wall (from {:?} to {:?}): only a surface moving along its wall (a belt, a shearing wall) is supported, not a wall moving across its line",
+                    "{v:?} is not along the wall (from {:?} to {:?}): it is the velocity of the wall's surface (a belt, a shearing wall); a wall that moves as a whole takes \"motion\": {{\"velocity\": ...}}",
                     w.from, w.to
                 ),
             ));
+        }
+        if let Some(m) = &w.motion {
+            wall_motion(&format!("walls[{k}].motion"), m)?;
+            if scene.domain.periodic_x && (m.velocity[0] != 0.0 || m.amplitude[0] != 0.0) {
+                return Err(SceneError::invalid(
+                    format!("walls[{k}].motion"),
+                    "moves along x in a domain periodic in x: a segment is not wrapped across the seam, so only motion along z is supported there (a surface moving along x is the wall's `velocity`)",
+                ));
+            }
         }
     }
     if scene.particles.is_empty() {
@@ -450,6 +458,38 @@ fn periodic(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
                 3.0 * reach
             ),
         ));
+    }
+    Ok(())
+}
+
+/// A wall's `motion`: finite, and an oscillation with a positive period (a period alone
+/// moves nothing).
+fn wall_motion(at: &str, m: &crate::scene::WallMotion) -> Result<(), SceneError> {
+    for (key, v) in [("velocity", m.velocity), ("amplitude", m.amplitude)] {
+        if !v.iter().all(|v| v.is_finite()) {
+            return Err(SceneError::invalid(
+                format!("{at}.{key}"),
+                format!("must be finite, got {v:?}"),
+            ));
+        }
+    }
+    match m.period {
+        Some(p) => {
+            finite_positive(&format!("{at}.period"), p)?;
+            if m.amplitude == [0.0; 2] {
+                return Err(SceneError::invalid(
+                    format!("{at}.period"),
+                    "goes with a non-zero amplitude (the oscillation A sin(2π t / T))",
+                ));
+            }
+        }
+        None if m.amplitude != [0.0; 2] => {
+            return Err(SceneError::invalid(
+                format!("{at}.period"),
+                "is required with an amplitude (the oscillation A sin(2π t / T))",
+            ));
+        }
+        None => {}
     }
     Ok(())
 }

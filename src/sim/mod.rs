@@ -23,6 +23,7 @@ mod energies;
 mod insert;
 mod order;
 mod start;
+mod walls;
 
 pub use divergence::Divergence;
 pub use energies::Energies;
@@ -94,6 +95,10 @@ pub struct Simulation {
     sorted: (Vec<u32>, u64),
     /// Whether the next evaluation rebuilds the list whatever the motion.
     force_rebuild: bool,
+    /// The time the moving walls are placed at (`place_walls`), and the one they were
+    /// at when the neighbour list was built.
+    wall_time: f64,
+    walls_listed_at: f64,
     /// Inside `advance`: the state is already predicted for the next step and surveyed
     /// (`correct_ahead`); the survey's answer.
     predicted: Option<bool>,
@@ -206,6 +211,8 @@ impl Simulation {
             reorders: 0,
             sorted: (Vec::new(), 0),
             force_rebuild: false,
+            wall_time: 0.0,
+            walls_listed_at: 0.0,
             predicted: None,
         })
     }
@@ -336,14 +343,20 @@ impl Simulation {
     /// not advance and keeps the springs as they were.
     pub fn evaluate_contacts(&mut self) {
         self.sync_ids();
+        self.place_walls(self.time());
         let moved = self.survey();
         self.evaluate_surveyed(moved);
     }
 
     /// `evaluate_contacts` after the survey; `moved`: its answer.
     fn evaluate_surveyed(&mut self, moved: bool) {
-        if moved || self.force_rebuild || self.neighbours.stale(&self.particles) {
+        if moved
+            || self.force_rebuild
+            || self.neighbours.stale(&self.particles)
+            || self.walls_moved()
+        {
             self.force_rebuild = false;
+            self.walls_listed_at = self.wall_time;
             let d = &self.scene.domain;
             let domain = (d.x, d.z);
             if self.reorder {
@@ -475,6 +488,8 @@ impl Simulation {
         let t = self.time();
         self.sync_ids();
         let gear = self.scene.integrator == IntegratorKind::Gear5;
+        // Gear evaluates the forces at the predicted state (t + dt), leapfrog at t.
+        self.place_walls(if gear { t + dt } else { t });
         let moved = match self.predicted.take() {
             // The last step predicted and surveyed this one (no insertion was due).
             Some(moved) => moved,
