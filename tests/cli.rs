@@ -943,7 +943,7 @@ fn a_source_whose_outlet_stays_taken_is_reported() {
         assert_eq!(code, 0, "{backend}: {err}");
         assert!(
             err.contains("point source 0 placed 0 of its 5 particles")
-                && err.contains("waited since t = 0.0000"),
+                && err.contains("fell behind its rate at t = 0.0000"),
             "{backend}: warned even with -q: {err}"
         );
         let summary: serde_json::Value =

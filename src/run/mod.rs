@@ -312,8 +312,10 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
     let wall = start.elapsed().as_secs_f64();
     let e = sim.energies();
     let sources = sim.source_progress();
-    // A source that stopped placing its particles (its spot at the outlet taken since
-    // then) leaves a deposit short of what the scene asked for: say so.
+    // A source that fell behind its rate (its next particle due ten of its intervals
+    // ago, its spot at the outlet taken when it last tried) leaves a deposit short of
+    // what the scene asked for: say so. Whether it placed none since or only fewer
+    // than its rate the state does not record, so the warning claims neither.
     for (p, _) in sources.iter().filter(|(_, stalled)| *stalled) {
         let copy = if sim.scene.replicas > 1 {
             format!("copy {}'s ", p.copy)
@@ -322,9 +324,10 @@ fn drive(engine: &mut Engine, opts: &RunOptions, claimed: Claimed) -> Result<Run
         };
         let at = p.next_at.unwrap_or_default();
         progress.warn(&format!(
-            "talus: warning: {copy}point source {} placed {} of its {} particles: its next one \
-             has waited since t = {:.4} for its spot at the outlet (x = {:.4}, z = {:.4}), \
-             taken at every step since (the deposit reached the outlet, or a grain stuck there)",
+            "talus: warning: {copy}point source {} placed {} of its {} particles: it fell \
+             behind its rate at t = {:.4} (its next particle fell due then) and its spot at \
+             the outlet (x = {:.4}, z = {:.4}) was taken when it last tried (the deposit \
+             reached the outlet, a grain stuck there, or grains crowd the outlet)",
             p.source,
             p.inserted,
             p.count,
