@@ -169,6 +169,10 @@ impl Rolling {
 pub struct RollingTable {
     pub side: usize,
     pub pairs: Vec<Rolling>,
+    /// Whether no pair resists rolling, and whether some pair keeps a spring: asked at
+    /// every contact, so kept.
+    none: bool,
+    spring: bool,
 }
 
 impl Default for RollingTable {
@@ -179,9 +183,15 @@ impl Default for RollingTable {
 
 impl RollingTable {
     pub fn uniform(r: Rolling) -> Self {
+        RollingTable::new(1, vec![r])
+    }
+
+    fn new(side: usize, pairs: Vec<Rolling>) -> Self {
         RollingTable {
-            side: 1,
-            pairs: vec![r],
+            side,
+            none: pairs.iter().all(Rolling::is_none),
+            spring: pairs.iter().any(Rolling::has_spring),
+            pairs,
         }
     }
 
@@ -209,7 +219,7 @@ impl RollingTable {
             pairs[a * side + b] = r;
             pairs[b * side + a] = r;
         }
-        Some(RollingTable { side, pairs })
+        Some(RollingTable::new(side, pairs))
     }
 
     /// The values of a contact between materials a and b (b = `walls()`: a wall).
@@ -229,12 +239,12 @@ impl RollingTable {
 
     /// Whether no pair resists rolling.
     pub fn is_none(&self) -> bool {
-        self.pairs.iter().all(Rolling::is_none)
+        self.none
     }
 
     /// Whether contacts keep a rolling spring (some pair under the spring–dashpot model).
     pub fn has_spring(&self) -> bool {
-        self.pairs.iter().any(Rolling::has_spring)
+        self.spring
     }
 
     /// What `talus check` says of it: the model, and the values of each pair of
