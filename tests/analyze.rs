@@ -942,6 +942,7 @@ fn an_m_shaped_base_load_has_its_side_maxima_above_the_centre() {
         length_unit: "sigma".into(),
         force_unit: "m g".into(),
         period_x: 0.0,
+        walls: Vec::new(),
     };
     let a = analyze::analyze(input, &Options::default()).unwrap();
     assert_eq!(a.base_forces.len(), 25);
@@ -1007,6 +1008,7 @@ fn base_input(name: &str, loads: &[f64]) -> analyze::input::Input {
         length_unit: "sigma".into(),
         force_unit: "m g".into(),
         period_x: 0.0,
+        walls: Vec::new(),
     }
 }
 

@@ -70,6 +70,7 @@ fn column(units: &str) -> Analysis {
         length_unit: length.into(),
         force_unit: force.into(),
         period_x: 0.0,
+        walls: Vec::new(),
     };
     analyze::analyze(input, &Options::default()).unwrap()
 }

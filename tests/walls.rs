@@ -361,3 +361,44 @@ fn wall_motions_are_refused_where_they_are_wrong_and_named_by_check() {
         "{out}"
     );
 }
+
+#[test]
+fn pictures_draw_the_walls_where_they_were() {
+    // The pressed rows run to t = 1.5 through `talus run`: the analysis of the final
+    // snapshot places each wall as the run did (the lid 0.045 lower, shifted sideways
+    // by 0.05 sin(2π · 1.5)), and the grains picture draws the four, cut to its view.
+    let dir = tmp("walls", "pictures");
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("rows.json");
+    let mut v = pressed_rows();
+    v["stop"] = json!({ "time": 1.5 });
+    std::fs::write(&scene, v.to_string()).unwrap();
+    let out = dir.join("run");
+    let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
+    talus_ok([
+        "run",
+        "-q",
+        "--backend",
+        "cpu",
+        &s(&scene),
+        "--out",
+        &s(&out),
+    ]);
+    let input = talus::analyze::input::load(&out, None).unwrap();
+    let t = input.time;
+    let lid = input.walls[3];
+    let dx = 0.05 * (std::f64::consts::TAU * t).sin();
+    let expected = [[-1.0 + dx, 1.9 - 0.03 * t], [12.0 + dx, 1.9 - 0.03 * t]];
+    for k in 0..2 {
+        for a in 0..2 {
+            assert!(
+                (lid[k][a] - expected[k][a]).abs() < 1e-12,
+                "the lid at t = {t}: {lid:?} against {expected:?}"
+            );
+        }
+    }
+    assert_eq!(input.walls[0], [[0.0, 0.0], [11.0, 0.0]]);
+    let svg = std::fs::read_to_string(out.join("pictures").join("grains.svg")).unwrap();
+    let lines = svg.matches("stroke=\"rgb(90,70,50)\"").count();
+    assert_eq!(lines, 4, "walls drawn in the grains picture: {lines}");
+}

@@ -90,6 +90,9 @@ pub struct Input {
     pub force_unit: String,
     /// The domain's period in x (scene `domain.periodic_x`), 0 when not periodic.
     pub period_x: f64,
+    /// The wall segments (scene `walls`) where they were at the snapshot's time: a
+    /// moving wall (`walls[k].motion`) placed as the run placed it.
+    pub walls: Vec<[P2; 2]>,
 }
 
 /// The snapshot a path names: a snapshot's .json, or a run folder (its final.json).
@@ -289,6 +292,20 @@ pub fn of_snapshot(
     let period_x = scene
         .and_then(|v| serde_json::from_value::<crate::scene::Domain>(v.get("domain")?.clone()).ok())
         .map_or(0.0, |d| d.period_x());
+    let walls = scene
+        .and_then(|v| {
+            serde_json::from_value::<Vec<crate::scene::Wall>>(v.get("walls")?.clone()).ok()
+        })
+        .unwrap_or_default()
+        .iter()
+        .map(|w| {
+            let d = w.motion.map_or([0.0; 2], |m| m.displacement(s.meta.time));
+            [
+                [w.from[0] + d[0], w.from[1] + d[1]],
+                [w.to[0] + d[0], w.to[1] + d[1]],
+            ]
+        })
+        .collect();
     let (length_unit, force_unit) = if units == "si" {
         ("m", "N")
     } else {
@@ -308,5 +325,6 @@ pub fn of_snapshot(
         length_unit: length_unit.into(),
         force_unit: force_unit.into(),
         period_x,
+        walls,
     })
 }

@@ -392,6 +392,21 @@ impl Canvas {
             .stroke_path(&path, &paint, &st, Transform::identity(), None);
     }
 
+    /// The wall segments, each cut to the view (a floor far wider than the heap must not
+    /// run into the legend strip under it).
+    fn walls(&mut self, walls: &[[[f64; 2]; 2]], width: f32) {
+        let v = self.view;
+        let (right, bottom) = (
+            v.left + v.width as f64 / v.scale,
+            v.top - v.height as f64 / v.scale,
+        );
+        for w in walls {
+            if let Some((a, b)) = clip(w[0], w[1], [v.left, bottom], [right, v.top]) {
+                self.line((a[0], a[1]), (b[0], b[1]), width, WALL);
+            }
+        }
+    }
+
     /// A dashed line from a to b: dashes and gaps `dash` long (world units).
     fn dashed(&mut self, a: (f64, f64), b: (f64, f64), width: f32, color: [u8; 3], dash: f64) {
         let length = (b.0 - a.0).hypot(b.1 - a.1);
@@ -418,7 +433,33 @@ impl Canvas {
     }
 }
 
+/// The part of segment a–b inside the box from `lo` to `hi` (Liang–Barsky), if any.
+fn clip(a: [f64; 2], b: [f64; 2], lo: [f64; 2], hi: [f64; 2]) -> Option<([f64; 2], [f64; 2])> {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for axis in 0..2 {
+        for (p, q) in [
+            (-d[axis], a[axis] - lo[axis]),
+            (d[axis], hi[axis] - a[axis]),
+        ] {
+            if p == 0.0 {
+                if q < 0.0 {
+                    return None;
+                }
+            } else if p < 0.0 {
+                t0 = t0.max(q / p);
+            } else {
+                t1 = t1.min(q / p);
+            }
+        }
+    }
+    let at = |t: f64| [a[0] + t * d[0], a[1] + t * d[1]];
+    (t0 <= t1).then(|| (at(t0), at(t1)))
+}
+
 const GREY: [u8; 3] = [200, 200, 200];
+/// The walls' colour.
+const WALL: [u8; 3] = [90, 70, 50];
 const INK: [u8; 3] = [30, 30, 30];
 const COMPRESSION: [u8; 3] = [30, 60, 200];
 const TENSION: [u8; 3] = [200, 40, 40];
@@ -493,6 +534,7 @@ pub fn render_marked(
         };
         c.shapes(g, period, fill, Some(INK), 0.5 * line);
     }
+    c.walls(&a.input.walls, 2.0 * line);
     legend::length_scale(&mut c, &a.input.length_unit);
     legend::caption(&mut c, &a.input);
     if let Some(s) = scale {
@@ -505,6 +547,7 @@ pub fn render_marked(
     for g in &a.input.grains {
         c.shapes(g, period, [235, 235, 235], Some(GREY), 0.5 * line);
     }
+    c.walls(&a.input.walls, 2.0 * line);
     let fmax = a
         .input
         .touches
@@ -662,4 +705,33 @@ fn repose_lines(
     legend::caption(&mut c, &a.input);
     legend::line_key(&mut c, "angle of repose [deg], left/right", &key);
     Ok(c)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::clip;
+
+    #[test]
+    fn a_wall_is_cut_to_the_view() {
+        let (lo, hi) = ([0.0, 0.0], [10.0, 5.0]);
+        // A floor far wider than the view: its middle part.
+        let (a, b) = clip([-100.0, 1.0], [100.0, 1.0], lo, hi).unwrap();
+        assert!(
+            (a[0] - 0.0).abs() < 1e-12 && (b[0] - 10.0).abs() < 1e-12,
+            "{a:?} {b:?}"
+        );
+        assert_eq!((a[1], b[1]), (1.0, 1.0));
+        // A side wall reaching below and above it.
+        assert_eq!(
+            clip([2.0, -3.0], [2.0, 30.0], lo, hi),
+            Some(([2.0, 0.0], [2.0, 5.0]))
+        );
+        // Inside, as it is; outside, nothing.
+        assert_eq!(
+            clip([1.0, 1.0], [3.0, 2.0], lo, hi),
+            Some(([1.0, 1.0], [3.0, 2.0]))
+        );
+        assert_eq!(clip([-5.0, -1.0], [20.0, -1.0], lo, hi), None);
+        assert_eq!(clip([-5.0, 0.0], [0.0, 10.0], lo, hi), None);
+    }
 }
