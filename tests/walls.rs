@@ -364,14 +364,15 @@ fn wall_motions_are_refused_where_they_are_wrong_and_named_by_check() {
 
 #[test]
 fn pictures_draw_the_walls_where_they_were() {
-    // The pressed rows run to t = 1.5 through `talus run`: the analysis of the final
-    // snapshot places each wall as the run did (the lid 0.045 lower, shifted sideways
-    // by 0.05 sin(2π · 1.5)), and the grains picture draws the four, cut to its view.
+    // The pressed rows run to t = 1.25 through `talus run`: the analysis of the final
+    // snapshot places each wall as the run did (the lid 0.0375 lower, shifted sideways
+    // by 0.05 sin(2π · 1.25) = 0.05), the grains picture draws those in its view, and
+    // walls.vtp holds them.
     let dir = tmp("walls", "pictures");
     std::fs::create_dir_all(&dir).unwrap();
     let scene = dir.join("rows.json");
     let mut v = pressed_rows();
-    v["stop"] = json!({ "time": 1.5 });
+    v["stop"] = json!({ "time": 1.25 });
     std::fs::write(&scene, v.to_string()).unwrap();
     let out = dir.join("run");
     let s = |p: &std::path::Path| p.to_str().unwrap().to_string();
@@ -400,5 +401,28 @@ fn pictures_draw_the_walls_where_they_were() {
     assert_eq!(input.walls[0], [[0.0, 0.0], [11.0, 0.0]]);
     let svg = std::fs::read_to_string(out.join("pictures").join("grains.svg")).unwrap();
     let lines = svg.matches("stroke=\"rgb(90,70,50)\"").count();
-    assert_eq!(lines, 4, "walls drawn in the grains picture: {lines}");
+    // The view is the heap's outline and a margin: the floor, the lid and the left
+    // side lie in it, the right side (0.45 beyond the grains) at its edge.
+    assert!(
+        (3..=4).contains(&lines),
+        "walls drawn in the grains picture: {lines}"
+    );
+    // walls.vtp for ParaView: the four lines, the lid where the analysis has it.
+    let vtp = common::vtp::read(&out.join("pictures").join("walls.vtp"));
+    let points = vtp.get("Points", "Points");
+    assert_eq!(points.len(), 4 * 6, "{points:?}");
+    let lid: Vec<f64> = points[18..24].to_vec();
+    let want = [
+        expected[0][0],
+        expected[0][1],
+        0.0,
+        expected[1][0],
+        expected[1][1],
+        0.0,
+    ];
+    assert!(
+        lid.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-6),
+        "walls.vtp's lid {lid:?} against {want:?}"
+    );
+    assert_eq!(vtp.get("CellData", "wall"), &[0.0, 1.0, 2.0, 3.0]);
 }

@@ -104,7 +104,7 @@ enum Command {
     },
     /// Pictures of a snapshot (or a run folder's final state) in PNG and SVG: grains
     /// coloured by a field, the force network, principal-stress crosses, profile plots;
-    /// and VTK files (grains.vtp, contacts.vtp) for ParaView.
+    /// and VTK files (grains.vtp, contacts.vtp, walls.vtp) for ParaView.
     Render {
         /// A snapshot's .json, or a run folder (its final.json).
         path: PathBuf,

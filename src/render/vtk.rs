@@ -183,19 +183,25 @@ fn write_piece(path: &Path, p: Piece) -> Result<(), RenderError> {
     write_atomic(path, &bytes).map_err(RenderError::write(path))
 }
 
-/// Writes `grains.vtp` and `contacts.vtp` into `dir`.
+/// Writes `grains.vtp`, `contacts.vtp` and, where the scene has walls, `walls.vtp`
+/// into `dir`.
 pub fn write(a: &Analysis, dir: &Path) -> Result<Vec<PathBuf>, RenderError> {
     write_named(a, dir, "")
 }
 
-/// A ParaView collection of (time, grains file, contacts file), relative to its folder.
-pub fn collection(entries: &[(f64, String, String)]) -> String {
+/// A ParaView collection of (time, files: grains, contacts and walls if any), relative
+/// to its folder; each file its part.
+pub fn collection(entries: &[(f64, Vec<String>)]) -> String {
     let mut s = String::from(
         "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n  <Collection>\n",
     );
-    for (t, g, c) in entries {
-        let _ = writeln!(s, r#"    <DataSet timestep="{t:e}" part="0" file="{g}"/>"#);
-        let _ = writeln!(s, r#"    <DataSet timestep="{t:e}" part="1" file="{c}"/>"#);
+    for (t, files) in entries {
+        for (part, f) in files.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                r#"    <DataSet timestep="{t:e}" part="{part}" file="{f}"/>"#
+            );
+        }
     }
     s.push_str("  </Collection>\n</VTKFile>\n");
     s
@@ -222,7 +228,8 @@ pub(super) fn net_loads(a: &Analysis) -> Vec<([f64; 2], f64)> {
     loads
 }
 
-/// Writes `{prefix}grains.vtp` and `{prefix}contacts.vtp` into `dir`.
+/// Writes `{prefix}grains.vtp`, `{prefix}contacts.vtp` and, where the scene has walls,
+/// `{prefix}walls.vtp` into `dir`; returns the files in that order.
 pub fn write_named(a: &Analysis, dir: &Path, prefix: &str) -> Result<Vec<PathBuf>, RenderError> {
     let grains = &a.input.grains;
     // VTK orders cells vertices first, then polygons: the disks, then the rest.
@@ -309,5 +316,20 @@ pub fn write_named(a: &Analysis, dir: &Path, prefix: &str) -> Result<Vec<PathBuf
     let p = dir.join(format!("{prefix}contacts.vtp"));
     write_piece(&p, piece)?;
     files.push(p);
+    // Walls: one line each, where it was at the snapshot's time (a moving wall placed).
+    let walls = &a.input.walls;
+    if !walls.is_empty() {
+        let mut piece = Piece::default();
+        for w in walls {
+            piece
+                .lines
+                .push(vec![piece.points.len(), piece.points.len() + 1]);
+            piece.points.extend(w);
+        }
+        piece.cell_data = vec![u32s("wall", 0..walls.len() as u32)];
+        let p = dir.join(format!("{prefix}walls.vtp"));
+        write_piece(&p, piece)?;
+        files.push(p);
+    }
     Ok(files)
 }

@@ -141,7 +141,8 @@ fn remove_later_outputs(out: &Path, step: u64) -> Result<usize, RunError> {
         };
         for e in entries.flatten() {
             let name = e.file_name().to_string_lossy().into_owned();
-            // snap_0000001000.json, .bin, _grains.vtp, _contacts.vtp; ckpt_0000001000.bin
+            // snap_0000001000.json, .bin, _grains.vtp, _contacts.vtp, _walls.vtp;
+            // ckpt_0000001000.bin
             let later = (name.strip_prefix(prefix))
                 .and_then(|rest| rest.get(..10))
                 .and_then(|digits| digits.parse::<u64>().ok())

@@ -289,8 +289,8 @@ pub struct Vtk {
     dir: PathBuf,
     /// The scene as `scene.json` holds it: gravity and friction for the analysis.
     scene: serde_json::Value,
-    /// (time, grains file, contacts file) of each one written.
-    entries: Vec<(f64, String, String)>,
+    /// (time, its files: grains, contacts and walls if any) of each one written.
+    entries: Vec<(f64, Vec<String>)>,
 }
 
 impl Output for Vtk {
@@ -320,12 +320,12 @@ impl Output for Vtk {
         if !self.vtk {
             return Ok(());
         }
-        render::vtk::write_named(&a, &self.dir, &prefix)?;
-        self.entries.push((
-            time,
-            format!("{prefix}grains.vtp"),
-            format!("{prefix}contacts.vtp"),
-        ));
+        let files = render::vtk::write_named(&a, &self.dir, &prefix)?;
+        let names = files
+            .iter()
+            .filter_map(|f| f.file_name().map(|n| n.to_string_lossy().into_owned()))
+            .collect();
+        self.entries.push((time, names));
         let pvd = self.dir.join("snapshots.pvd");
         let text = render::vtk::collection(&self.entries);
         write_atomic(&pvd, text.as_bytes()).map_err(io(&pvd))
