@@ -326,6 +326,12 @@ fn wall_motions_are_refused_where_they_are_wrong_and_named_by_check() {
             "positive",
         ),
         (json!({ "speed": 1.0 }), "speed", ""),
+        // 0.3 per step of 1e-3, beyond half the smallest radius (0.25).
+        (
+            json!({ "velocity": [0.0, -300.0] }),
+            "walls[3].motion",
+            "max_step_displacement",
+        ),
     ] {
         v["walls"][3]["motion"] = motion.clone();
         let text = talus::scene::parse(&v.to_string(), &[])

@@ -434,6 +434,7 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
     let law = ContactLaw::of_scene(scene)?;
     spheropolygons(scene, &law)?;
     rolling(scene, &law)?;
+    wall_speeds(scene)?;
     periodic(scene, &law)?;
     warnings.extend(super::stability::time_step(scene, &law)?);
     Ok(Checked { law, warnings })
@@ -458,6 +459,36 @@ fn periodic(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
                 3.0 * reach
             ),
         ));
+    }
+    Ok(())
+}
+
+/// A moving wall may not move farther in one step than a particle may
+/// (`limits.max_step_displacement` of the smallest radius): beyond it grains pass
+/// through the wall between two steps without meeting it.
+fn wall_speeds(scene: &Scene) -> Result<(), SceneError> {
+    let bound = scene.limits.max_step_displacement;
+    if bound <= 0.0 {
+        return Ok(());
+    }
+    let smallest = (scene.particles.iter())
+        .map(|c| super::sizes::size_bounds(c).0)
+        .fold(f64::INFINITY, f64::min);
+    for (k, w) in scene.walls.iter().enumerate() {
+        let Some(m) = w.motion else {
+            continue;
+        };
+        let step = m.top_speed() * scene.dt;
+        if step > bound * 0.5 * smallest {
+            return Err(SceneError::invalid(
+                format!("walls[{k}].motion"),
+                format!(
+                    "moves the wall by up to {step:.4e} in a step of dt = {}, more than limits.max_step_displacement = {bound} of the smallest radius ({:.4e}): grains would pass through it; slow it down or reduce dt",
+                    scene.dt,
+                    0.5 * smallest
+                ),
+            ));
+        }
     }
     Ok(())
 }
