@@ -66,6 +66,9 @@ fn small_run(dir: &Path) -> PathBuf {
     v["particles"][1]["particles"][0] =
         json!({ "position": [2.0, 1.6], "theta": 0.3, "diameter": 1.0 });
     v["name"] = json!("python-reader");
+    // The floor shakes sideways (a moving wall, `talus.walls_at`).
+    v["walls"][0]["motion"] =
+        json!({ "velocity": [0.1, 0.0], "amplitude": [0.01, 0.0], "period": 0.07 });
     v["stop"] = json!({ "time": 0.05 });
     v["output"] = json!({ "snapshot_every": 0.02, "log_every": 0.01, "checkpoint_every": 0 });
     let scene = dir.join("scene.json");
@@ -97,6 +100,7 @@ print(json.dumps({
     "vertices": [v.tolist() for v in s["vertices"]],
     "i": c["i"].tolist(), "j": c["j"].tolist(), "force": c["force"].tolist(),
     "point": c["point"].tolist(), "overlap": c["overlap"].tolist(),
+    "walls": talus.walls_at(run["scene"], s["time"]).tolist(),
 }))
 "#;
 
@@ -186,6 +190,20 @@ fn the_python_reader_reads_what_the_rust_one_reads() {
     assert!(times.windows(2).all(|w| w[0] < w[1]), "{times:?}");
     assert!(list(&got["log_time"]).len() >= 4);
     assert_eq!(got["summary_time"].as_f64(), Some(s.meta.time));
+    // The walls where the run had them at the final time, as the Rust analysis places
+    // them (the same formula in numpy: to rounding).
+    let walls = talus::analyze::input::load(&run, None).unwrap().walls;
+    let py_walls = got["walls"].as_array().unwrap();
+    assert_eq!(py_walls.len(), walls.len());
+    for (w, p) in walls.iter().zip(py_walls) {
+        for (end, q) in w.iter().zip(pairs(p)) {
+            assert!(
+                (end[0] - q[0]).abs() < 1e-12 && (end[1] - q[1]).abs() < 1e-12,
+                "wall end {q:?} against {end:?}"
+            );
+        }
+    }
+    assert!((walls[0][0][0] + 5.0).abs() > 1e-3, "the floor moved");
 }
 
 #[test]

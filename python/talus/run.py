@@ -76,3 +76,20 @@ def read_run(path, verify=True):
         "snapshots": Snapshots(paths, verify),
         "final": read_snapshot(final, verify) if os.path.isfile(final) else None,
     }
+
+
+def walls_at(scene, t):
+    """The scene's wall segments where they were at time t, as an array of shape
+    (walls, 2, 2) (each wall's two ends, x and z): a wall with a `motion` moved by
+    v t + A sin(2 pi t / T), as talus moves it (src/scene/schema.rs
+    `WallMotion::displacement`). `scene` is a run's `scene.json` (`read_run(...)["scene"]`)."""
+    out = []
+    for w in scene.get("walls", []):
+        m = w.get("motion") or {}
+        v = np.asarray(m.get("velocity", [0.0, 0.0]), dtype=float)
+        a = np.asarray(m.get("amplitude", [0.0, 0.0]), dtype=float)
+        period = m.get("period")
+        omega = 2.0 * np.pi / period if period is not None and np.any(a != 0.0) else 0.0
+        d = v * t + a * np.sin(omega * t)
+        out.append([np.asarray(w["from"], dtype=float) + d, np.asarray(w["to"], dtype=float) + d])
+    return np.array(out, dtype=float).reshape(-1, 2, 2)
