@@ -12,6 +12,7 @@ mod sizes;
 mod stability;
 mod strict;
 mod validate;
+mod walls;
 
 pub use crate::law::spec::*;
 pub use overrides::apply_override;

@@ -6,7 +6,7 @@ use super::sizes::{estimated_particles, material_of, polygon_of, reach_bound_of,
 use super::{ContactSpec, Creation, PolygonSpec, Scene, SceneError, Size};
 use crate::law::ContactLaw;
 
-fn finite_positive(path: &str, v: f64) -> Result<(), SceneError> {
+pub(super) fn finite_positive(path: &str, v: f64) -> Result<(), SceneError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {
@@ -273,7 +273,7 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
             ));
         }
         if let Some(m) = &w.motion {
-            wall_motion(&format!("walls[{k}].motion"), m)?;
+            super::walls::wall_motion(&format!("walls[{k}].motion"), m)?;
             if scene.domain.periodic_x && (m.velocity[0] != 0.0 || m.amplitude[0] != 0.0) {
                 return Err(SceneError::invalid(
                     format!("walls[{k}].motion"),
@@ -434,7 +434,7 @@ pub(super) fn check(scene: &Scene) -> Result<Checked, SceneError> {
     let law = ContactLaw::of_scene(scene)?;
     spheropolygons(scene, &law)?;
     rolling(scene, &law)?;
-    wall_speeds(scene)?;
+    super::walls::wall_speeds(scene)?;
     periodic(scene, &law)?;
     warnings.extend(super::stability::time_step(scene, &law)?);
     Ok(Checked { law, warnings })
@@ -459,68 +459,6 @@ fn periodic(scene: &Scene, law: &ContactLaw) -> Result<(), SceneError> {
                 3.0 * reach
             ),
         ));
-    }
-    Ok(())
-}
-
-/// A moving wall may not move farther in one step than a particle may
-/// (`limits.max_step_displacement` of the smallest radius): beyond it grains pass
-/// through the wall between two steps without meeting it.
-fn wall_speeds(scene: &Scene) -> Result<(), SceneError> {
-    let bound = scene.limits.max_step_displacement;
-    if bound <= 0.0 {
-        return Ok(());
-    }
-    let smallest = (scene.particles.iter())
-        .map(|c| super::sizes::size_bounds(c).0)
-        .fold(f64::INFINITY, f64::min);
-    for (k, w) in scene.walls.iter().enumerate() {
-        let Some(m) = w.motion else {
-            continue;
-        };
-        let step = m.top_speed() * scene.dt;
-        if step > bound * 0.5 * smallest {
-            return Err(SceneError::invalid(
-                format!("walls[{k}].motion"),
-                format!(
-                    "moves the wall by up to {step:.4e} in a step of dt = {}, more than limits.max_step_displacement = {bound} of the smallest radius ({:.4e}): grains would pass through it; slow it down or reduce dt",
-                    scene.dt,
-                    0.5 * smallest
-                ),
-            ));
-        }
-    }
-    Ok(())
-}
-
-/// A wall's `motion`: finite, and an oscillation with a positive period (a period alone
-/// moves nothing).
-fn wall_motion(at: &str, m: &crate::scene::WallMotion) -> Result<(), SceneError> {
-    for (key, v) in [("velocity", m.velocity), ("amplitude", m.amplitude)] {
-        if !v.iter().all(|v| v.is_finite()) {
-            return Err(SceneError::invalid(
-                format!("{at}.{key}"),
-                format!("must be finite, got {v:?}"),
-            ));
-        }
-    }
-    match m.period {
-        Some(p) => {
-            finite_positive(&format!("{at}.period"), p)?;
-            if m.amplitude == [0.0; 2] {
-                return Err(SceneError::invalid(
-                    format!("{at}.period"),
-                    "goes with a non-zero amplitude (the oscillation A sin(2π t / T))",
-                ));
-            }
-        }
-        None if m.amplitude != [0.0; 2] => {
-            return Err(SceneError::invalid(
-                format!("{at}.period"),
-                "is required with an amplitude (the oscillation A sin(2π t / T))",
-            ));
-        }
-        None => {}
     }
     Ok(())
 }
