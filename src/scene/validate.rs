@@ -6,7 +6,7 @@ use super::sizes::{estimated_particles, material_of, polygon_of, reach_bound_of,
 use super::{ContactSpec, Creation, PolygonSpec, Scene, SceneError, Size};
 use crate::law::ContactLaw;
 
-pub(super) fn finite_positive(path: &str, v: f64) -> Result<(), SceneError> {
+fn finite_positive(path: &str, v: f64) -> Result<(), SceneError> {
     if v.is_finite() && v > 0.0 {
         Ok(())
     } else {

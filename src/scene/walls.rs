@@ -1,7 +1,6 @@
 //! The checks of walls that move (`walls[k].motion`, src/sim/walls.rs), beside the
 //! scene's other checks (validate.rs).
 
-use super::validate::finite_positive;
 use super::{Scene, SceneError};
 
 /// A moving wall may not move farther in one step than a particle may
@@ -47,7 +46,12 @@ pub(super) fn wall_motion(at: &str, m: &crate::scene::WallMotion) -> Result<(), 
     }
     match m.period {
         Some(p) => {
-            finite_positive(&format!("{at}.period"), p)?;
+            if !(p.is_finite() && p > 0.0) {
+                return Err(SceneError::invalid(
+                    format!("{at}.period"),
+                    format!("must be positive, got {p}"),
+                ));
+            }
             if m.amplitude == [0.0; 2] {
                 return Err(SceneError::invalid(
                     format!("{at}.period"),
