@@ -155,7 +155,8 @@ fn continuous(c: ContactInput) -> ContactOutput {
     // Eq. 6: the spins on the centre distance as written, or the surfaces' slip.
     var slip = c.v_centres - c.spin * c.r;
     if ((params.reading & READING_CONTACT_ARM) != 0u) { slip = c.v_t; }
-    let delta_f = clamp(c.history + slip * c.dt, -delta_max, delta_max);
+    var delta_f = c.history + slip * c.dt;
+    if ((params.reading & READING_ACCUMULATE) == 0u) { delta_f = clamp(delta_f, -delta_max, delta_max); }
     let mu_f_e = params.mu * f_e;
     let spring = tapered_friction(delta_f, delta_max, mu_f_e);
     let k_t = tapered_stiffness(delta_f, delta_max, mu_f_e);

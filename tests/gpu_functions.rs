@@ -124,6 +124,12 @@ fn wgsl_laws_match_their_rust_twins() {
             5e-5,
         ),
         (
+            "continuous, δ_F accumulated beyond δ_max",
+            json!({ "law": "continuous", "n": 36.0, "r0": 1.2, "mu": 0.5,
+                    "tangential_limit": "accumulate" }),
+            5e-5,
+        ),
+        (
             "Hooke-equivalent, as talus read it before issue 39",
             json!({ "law": "hooke_equivalent", "n": 36.0, "r0": 1.2, "mu": 0.5, "clamp": true,
                     "tangential_damping": "slip", "rolling_arm": "contact_point" }),

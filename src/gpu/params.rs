@@ -76,7 +76,7 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             p.alpha = c.alpha as f32;
             p.damping_fraction = c.damping_fraction as f32;
             p.g_scale = c.g as f32;
-            use crate::scene::{RollingArm, TangentialDamping};
+            use crate::scene::{RollingArm, TangentialDamping, TangentialLimit};
             p.clamp = c.reading.clamp as u32;
             p.reading = match c.reading.damping {
                 TangentialDamping::Centres => 0,
@@ -84,6 +84,9 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
             } | match c.reading.arm {
                 RollingArm::CentreDistance => 0,
                 RollingArm::ContactPoint => layout::READING_CONTACT_ARM,
+            } | match c.reading.limit {
+                TangentialLimit::Hold => 0,
+                TangentialLimit::Accumulate => layout::READING_ACCUMULATE,
             };
         }
     }

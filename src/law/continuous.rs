@@ -4,7 +4,9 @@
 //! Lengths enter through σ = (d1 + d2)/2 and forces through m g with m = 2 m12, so the
 //! law is the paper's reduced-unit law for any units and for unequal disks.
 
-use super::spec::{ContinuousSpec, HookeEquivalentSpec, ParamError, RollingArm, TangentialDamping};
+use super::spec::{
+    ContinuousSpec, HookeEquivalentSpec, ParamError, RollingArm, TangentialDamping, TangentialLimit,
+};
 use super::spring_dashpot::{non_negative, positive};
 use super::tangential::{tapered_energy, tapered_friction, tapered_stiffness};
 use super::{ContactInput, ContactOutput, clamp_non_negative};
@@ -40,6 +42,7 @@ pub struct Reading {
     pub clamp: bool,
     pub damping: TangentialDamping,
     pub arm: RollingArm,
+    pub limit: TangentialLimit,
 }
 
 impl Continuous {
@@ -64,6 +67,7 @@ impl Continuous {
                 clamp: s.clamp,
                 damping: s.tangential_damping,
                 arm: s.rolling_arm,
+                limit: s.tangential_limit,
             },
         })
     }
@@ -102,6 +106,7 @@ impl Continuous {
                 clamp: s.clamp,
                 damping: s.tangential_damping,
                 arm: s.rolling_arm,
+                limit: s.tangential_limit,
             },
         })
     }
@@ -130,14 +135,19 @@ impl Continuous {
         let delta_n = (self.r0 * c.sigma - c.r).max(0.0);
         let delta_max = self.alpha * self.mu * delta_n;
         // Eq. 6: δ_F accumulates ṙ_ij · t̂ − (θ̇_i + θ̇_j) r_ij, the spins' arm the centre
-        // distance as written, or each disk's own (the surfaces' slip, `v_t`). It is held
-        // at ±δ_max while sliding so that a reversal starts from the Coulomb limit rather
-        // than unwinding a long excursion (the paper leaves this open).
+        // distance as written, or each disk's own (the surfaces' slip, `v_t`). By default
+        // it is held at ±δ_max while sliding so that a reversal starts from the Coulomb
+        // limit rather than unwinding a long excursion (the paper leaves this open:
+        // `TangentialLimit`).
         let slip = match self.reading.arm {
             RollingArm::CentreDistance => c.v_centres - c.spin * c.r,
             RollingArm::ContactPoint => c.v_t,
         };
-        let delta_f = (c.history + slip * c.dt).clamp(-delta_max, delta_max);
+        let delta_f = c.history + slip * c.dt;
+        let delta_f = match self.reading.limit {
+            TangentialLimit::Hold => delta_f.clamp(-delta_max, delta_max),
+            TangentialLimit::Accumulate => delta_f,
+        };
         let mu_f_e = self.mu * f_e;
         let spring = tapered_friction(delta_f, delta_max, mu_f_e);
         let k_t = tapered_stiffness(delta_f, delta_max, mu_f_e);
@@ -340,6 +350,51 @@ mod tests {
         let c_t = 0.5 * 2.0 * k_t.sqrt();
         let want = tapered_friction(out.history, delta_max, mu_f_e) - c_t * v_t;
         assert!((out.f_t - want).abs() < 1e-12, "{} against {want}", out.f_t);
+    }
+
+    #[test]
+    fn delta_f_is_held_at_its_limit_or_accumulates_beyond_it() {
+        // A resting pair (r = σ, δ_max = α μ 0.2σ) whose δ_F already stands at 2 δ_max.
+        let mut l = law();
+        let delta_max = l.alpha * l.mu * (l.r0 - 1.0);
+        let mu_f_e = l.mu * l.elastic_force(1.0, 1.0, 1.0);
+        let input = |v: f64| ContactInput {
+            r: 1.0,
+            sigma: 1.0,
+            v_centres: v,
+            m12: 0.5,
+            mass: 1.0,
+            history: 2.0 * delta_max,
+            dt: 1e-3,
+            ..Default::default()
+        };
+        // Sliding on: held at δ_max (a spring that slides), or carried on; μ F_e either
+        // way, undamped (k_T = 0 at the limit).
+        let held = l.evaluate(&input(0.5));
+        assert_eq!(held.history, delta_max);
+        assert!((held.f_t + mu_f_e).abs() < 1e-15, "{}", held.f_t);
+        l.reading.limit = TangentialLimit::Accumulate;
+        let carried = l.evaluate(&input(0.5));
+        assert_eq!(carried.history, 2.0 * delta_max + 0.5e-3);
+        assert!((carried.f_t + mu_f_e).abs() < 1e-15, "{}", carried.f_t);
+        // Turning back by 0.1 δ_max: the held spring comes down eq. 5's curve at once,
+        // the accumulated one stays at μ F_e, pulling the new way until δ_F is back
+        // under δ_max (no sliding dissipation).
+        let back = -0.1 * delta_max / 1e-3;
+        let carried = l.evaluate(&input(back));
+        assert!((carried.f_t + mu_f_e).abs() < 1e-15, "{}", carried.f_t);
+        l.reading.limit = TangentialLimit::Hold;
+        let mut c = input(back);
+        c.history = delta_max;
+        let held = l.evaluate(&c);
+        let spring = tapered_friction(0.9 * delta_max, delta_max, mu_f_e);
+        assert!(spring < 0.97 * mu_f_e);
+        let c_t = 0.5 * 2.0 * tapered_stiffness(0.9 * delta_max, delta_max, mu_f_e).sqrt();
+        assert!(
+            (held.f_t - (-spring - c_t * back)).abs() < 1e-12,
+            "{}",
+            held.f_t
+        );
     }
 
     #[test]

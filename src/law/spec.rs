@@ -245,6 +245,9 @@ pub struct ContinuousSpec {
     /// The arm of the disks' spins in eq. 6's slip and of f_t in eq. 13's torques.
     #[serde(default)]
     pub rolling_arm: RollingArm,
+    /// What δ_F does beyond ±δ_max (eq. 5 is silent): held there, or accumulated.
+    #[serde(default)]
+    pub tangential_limit: TangentialLimit,
 }
 
 /// Hooke law equivalent to the continuous one by equal work (paper 001 eq. 14).
@@ -279,6 +282,9 @@ pub struct HookeEquivalentSpec {
     /// The arm of the disks' spins in eq. 6's slip and of f_t in eq. 13's torques.
     #[serde(default)]
     pub rolling_arm: RollingArm,
+    /// What δ_F does beyond ±δ_max (eq. 5 is silent): held there, or accumulated.
+    #[serde(default)]
+    pub tangential_limit: TangentialLimit,
 }
 
 /// What paper 001 eq. 4's tangential damping −C_T (ṙ_ij · t̂) acts on (SPEC 2.2).
@@ -309,6 +315,21 @@ pub enum RollingArm {
     /// Each disk's own distance to the contact point (σ/2 for equal disks): the surfaces'
     /// physical slip (what talus did before issue 39).
     ContactPoint,
+}
+
+/// What paper 001's δ_F (eq. 6) does once |δ_F| reaches δ_max = α μ δ_N: eq. 5 gives
+/// F = μ F_N there and says no more (SPEC 2.2: "F_T = μ F_N once |δ_F| ≥ δ_max").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TangentialLimit {
+    /// Held at ±δ_max while sliding (and cut to a shrinking δ_max), so that a reversal
+    /// starts down eq. 5's curve at once: a spring that slides.
+    #[default]
+    Hold,
+    /// Accumulated by eq. 6's integral without bound: the force stays at μ F_N until the
+    /// contact has slid back by all of its excess, pulling the way it slid from (a
+    /// memory of the whole excursion; the plain reading of eq. 5 and 6 as code).
+    Accumulate,
 }
 
 fn default_n() -> f64 {
