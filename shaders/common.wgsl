@@ -72,6 +72,7 @@ const HALT_PAUSED: u32 = 32u;
 const READING_SLIP_DAMPING: u32 = 1u;
 const READING_CONTACT_ARM: u32 = 2u;
 const READING_ACCUMULATE: u32 = 4u;
+const READING_SLIDE: u32 = 8u;
 // Candidates of one source looked at per step.
 const INSERT_WINDOW: u32 = 4u;
 // Gear values per degree of freedom (State.q; src/state.rs).
@@ -152,7 +153,7 @@ struct Params {
     pair_side: u32,
     per_mass: u32,
     // The continuous law's readings of paper 001 (src/law/continuous.rs `Reading`):
-    // READING_SLIP_DAMPING | READING_CONTACT_ARM | READING_ACCUMULATE, 0 for the
+    // READING_SLIP_DAMPING | READING_CONTACT_ARM | READING_ACCUMULATE | READING_SLIDE, 0 for the
     // default readings; its clamp
     // is `clamp`.
     reading: u32,

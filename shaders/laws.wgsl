@@ -156,7 +156,12 @@ fn continuous(c: ContactInput) -> ContactOutput {
     var slip = c.v_centres - c.spin * c.r;
     if ((params.reading & READING_CONTACT_ARM) != 0u) { slip = c.v_t; }
     var delta_f = c.history + slip * c.dt;
-    if ((params.reading & READING_ACCUMULATE) == 0u) { delta_f = clamp(delta_f, -delta_max, delta_max); }
+    if ((params.reading & READING_SLIDE) != 0u) {
+        let bound = max(delta_max, abs(c.history));
+        delta_f = clamp(delta_f, -bound, bound);
+    } else if ((params.reading & READING_ACCUMULATE) == 0u) {
+        delta_f = clamp(delta_f, -delta_max, delta_max);
+    }
     let mu_f_e = params.mu * f_e;
     let spring = tapered_friction(delta_f, delta_max, mu_f_e);
     let k_t = tapered_stiffness(delta_f, delta_max, mu_f_e);

@@ -130,6 +130,12 @@ fn wgsl_laws_match_their_rust_twins() {
             5e-5,
         ),
         (
+            "continuous, δ_F capped by sliding only",
+            json!({ "law": "continuous", "n": 36.0, "r0": 1.2, "mu": 0.5,
+                    "tangential_limit": "slide" }),
+            5e-5,
+        ),
+        (
             "Hooke-equivalent, as talus read it before issue 39",
             json!({ "law": "hooke_equivalent", "n": 36.0, "r0": 1.2, "mu": 0.5, "clamp": true,
                     "tangential_damping": "slip", "rolling_arm": "contact_point" }),

@@ -111,6 +111,7 @@ pub fn shared() -> Vec<(&'static str, Value)> {
         u("READING_SLIP_DAMPING", layout::READING_SLIP_DAMPING),
         u("READING_CONTACT_ARM", layout::READING_CONTACT_ARM),
         u("READING_ACCUMULATE", layout::READING_ACCUMULATE),
+        u("READING_SLIDE", layout::READING_SLIDE),
         u("INSERT_WINDOW", layout::INSERT_WINDOW),
         u("GEAR_VALUES", crate::state::GEAR_VALUES),
         u("MAX_PAIR_SLOTS", layout::MAX_PAIR_SLOTS),

@@ -84,10 +84,12 @@ pub mod control {
 
 /// `Params::reading` bits: the continuous law's tangential damping on the surfaces'
 /// slip (not the centres' velocity), eq. 6's spins on each disk's own arm (not the
-/// centre distance), and δ_F accumulated beyond ±δ_max (not held there).
+/// centre distance), and δ_F accumulated beyond ±δ_max or capped by sliding only (not
+/// held within ±δ_max).
 pub const READING_SLIP_DAMPING: u32 = 1;
 pub const READING_CONTACT_ARM: u32 = 2;
 pub const READING_ACCUMULATE: u32 = 4;
+pub const READING_SLIDE: u32 = 8;
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
@@ -149,8 +151,8 @@ pub struct Params {
     pub pair_side: u32,
     pub per_mass: u32,
     /// The continuous law's readings of paper 001 (src/law/continuous.rs `Reading`):
-    /// `READING_SLIP_DAMPING` | `READING_CONTACT_ARM` | `READING_ACCUMULATE`, 0 for the
-    /// default readings.
+    /// `READING_SLIP_DAMPING` | `READING_CONTACT_ARM` | `READING_ACCUMULATE` |
+    /// `READING_SLIDE`, 0 for the default readings.
     pub reading: u32,
     /// Rolling resistance at disk contacts (src/law/rolling.rs), whose values per pair
     /// ride in `pair_law[2s + 1].yzw`: here the largest μ_r of any pair (0: none) and

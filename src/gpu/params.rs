@@ -86,6 +86,7 @@ pub fn law_params(law: &ContactLaw, p: &mut Params) {
                 RollingArm::ContactPoint => layout::READING_CONTACT_ARM,
             } | match c.reading.limit {
                 TangentialLimit::Hold => 0,
+                TangentialLimit::Slide => layout::READING_SLIDE,
                 TangentialLimit::Accumulate => layout::READING_ACCUMULATE,
             };
         }

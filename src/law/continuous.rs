@@ -146,6 +146,10 @@ impl Continuous {
         let delta_f = c.history + slip * c.dt;
         let delta_f = match self.reading.limit {
             TangentialLimit::Hold => delta_f.clamp(-delta_max, delta_max),
+            TangentialLimit::Slide => {
+                let bound = delta_max.max(c.history.abs());
+                delta_f.clamp(-bound, bound)
+            }
             TangentialLimit::Accumulate => delta_f,
         };
         let mu_f_e = self.mu * f_e;
@@ -395,6 +399,35 @@ mod tests {
             "{}",
             held.f_t
         );
+    }
+
+    #[test]
+    fn sliding_caps_delta_f_and_a_shrinking_limit_does_not_cut_it() {
+        // A pair eased apart to r = 1.1σ (δ_max = α μ 0.1σ) with δ_F = 0.08σ from when
+        // it was pressed closer: `hold` cuts δ_F to the new δ_max, `slide` keeps it.
+        let mut l = law();
+        let delta_max = l.alpha * l.mu * (l.r0 - 1.1);
+        let input = |v: f64, history: f64| ContactInput {
+            r: 1.1,
+            sigma: 1.0,
+            v_centres: v,
+            m12: 0.5,
+            mass: 1.0,
+            history,
+            dt: 1e-3,
+            ..Default::default()
+        };
+        assert!(0.08 > delta_max);
+        assert_eq!(l.evaluate(&input(0.0, 0.08)).history, delta_max);
+        l.reading.limit = TangentialLimit::Slide;
+        assert_eq!(l.evaluate(&input(0.0, 0.08)).history, 0.08);
+        // Sliding on does not take it further; sliding back unwinds it.
+        assert_eq!(l.evaluate(&input(1.0, 0.08)).history, 0.08);
+        assert_eq!(l.evaluate(&input(-1.0, 0.08)).history, 0.08 - 1e-3);
+        // Within δ_max it is the held spring's.
+        let inside = input(1.0, 0.5 * delta_max);
+        assert_eq!(l.evaluate(&inside).history, 0.5 * delta_max + 1e-3);
+        assert_eq!(l.evaluate(&input(1.0, delta_max)).history, delta_max);
     }
 
     #[test]

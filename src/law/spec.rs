@@ -326,6 +326,11 @@ pub enum TangentialLimit {
     /// starts down eq. 5's curve at once: a spring that slides.
     #[default]
     Hold,
+    /// Capped only by sliding: δ_F grows no further than the larger of δ_max and its
+    /// last value, and a δ_max that shrinks (the pair easing apart) does not cut it, so
+    /// that a contact whose normal load dips and comes back holds the same tangential
+    /// force as before instead of slipping by what the dip cut.
+    Slide,
     /// Accumulated by eq. 6's integral without bound: the force stays at μ F_N until the
     /// contact has slid back by all of its excess, pulling the way it slid from (a
     /// memory of the whole excursion; the plain reading of eq. 5 and 6 as code).
