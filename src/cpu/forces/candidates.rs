@@ -335,7 +335,9 @@ pub(super) fn settle(
             Some(c)
         }
         None => {
-            kick.contact = false;
+            // Zero force and torque: the reduction adds every candidate's kick without a
+            // branch (adding +0 to a sum that starts at +0 changes no bit).
+            *kick = Kick::default();
             *h = 0.0;
             None
         }

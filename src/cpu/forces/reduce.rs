@@ -32,16 +32,16 @@ pub fn reduce_candidate_forces(
 pub fn kick_sum(list: &NeighbourList, kicks: &[Kick], p: usize) -> Dof {
     let mut acc = [0.0; 3];
     let down = &list.down[list.down_start[p] as usize..list.down_start[p + 1] as usize];
+    // A candidate out of contact has a zero kick (`settle`): summed without a branch,
+    // the same bits as skipping it (the sums start at +0 and never become −0).
     for &k in down {
         let c = &kicks[k as usize];
-        if c.contact {
-            acc[0] -= c.force[0];
-            acc[1] -= c.force[1];
-            acc[2] -= c.torque[1];
-        }
+        acc[0] -= c.force[0];
+        acc[1] -= c.force[1];
+        acc[2] -= c.torque[1];
     }
     let own = &kicks[list.start[p] as usize..list.start[p + 1] as usize];
-    for c in own.iter().filter(|c| c.contact) {
+    for c in own {
         acc[0] += c.force[0];
         acc[1] += c.force[1];
         acc[2] += c.torque[0];
